@@ -1,0 +1,550 @@
+"""Case files (TOML) -> typed, validated dataclasses.
+
+Every key carries its unit in its name (``_um``, ``_s``, ``_C``, ``_Pa`` ...). Lengths in case
+files are micrometres and temperatures degrees Celsius because that is how the paper states
+them; :class:`Case` converts nothing -- the solver converts to SI (m, K) when it builds fields.
+
+All validation happens here, before any work, and every failure raises :class:`CaseError`
+naming the key, the value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+class CaseError(ValueError):
+    """A case file (or an override) is invalid. The message names key, value and what is allowed."""
+
+
+def _opt(
+    default: Any = dataclasses.MISSING,
+    *,
+    choices: tuple | None = None,
+    positive: bool = False,
+    nonneg: bool = False,
+    doc: str = "",
+    factory: Any = None,
+) -> Any:
+    meta = {"choices": choices, "positive": positive, "nonneg": nonneg, "doc": doc}
+    if factory is not None:
+        return field(default_factory=factory, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+@dataclass
+class CaseInfo:
+    name: str = _opt("case", doc="case name; default output folder is out/<name>")
+    description: str = _opt("", doc="free text")
+
+
+@dataclass
+class Grid:
+    spacing_um: float = _opt(2.0, positive=True, doc="grid spacing h (um)")
+    points_per_cell: int = _opt(
+        2, positive=True, doc="material points per cell along each axis (2 -> 2x2 quarter points)"
+    )
+    ghost_cells: int = _opt(
+        1, nonneg=True, doc="extra cells beyond left/right/bottom walls (surface tension stencil)"
+    )
+
+
+@dataclass
+class Domain:
+    width_um: float = _opt(80.0, positive=True, doc="domain width (um); x from 0")
+    height_um: float = _opt(48.0, positive=True, doc="domain height (um); y from 0 (baseplate)")
+
+
+@dataclass
+class Body:
+    shape: str = _opt("disc", choices=("disc", "rect"), doc="disc or axis-aligned rectangle")
+    material: str = _opt("PA12", doc="name of a [materials.NAME] table")
+    center_um: list[float] = _opt(factory=lambda: [20.0, 20.0], doc="disc centre (um)")
+    radius_um: float = _opt(20.0, positive=True, doc="disc radius (um)")
+    min_um: list[float] = _opt(factory=lambda: [0.0, 0.0], doc="rectangle lower-left corner (um)")
+    max_um: list[float] = _opt(factory=lambda: [10.0, 10.0], doc="rectangle upper-right (um)")
+    temperature_C: float | None = _opt(None, doc="initial temperature; default thermal.initial_C")
+    velocity_m_s: list[float] = _opt(factory=lambda: [0.0, 0.0], doc="initial velocity (m/s)")
+
+
+@dataclass
+class Material:
+    """Every parameter of the paper's Table 3. `_solid` holds for T <= T_c, `_liquid` for
+    T >= T_m; in between they are interpolated linearly in the solid fraction (eq. 33)."""
+
+    density_kg_m3: float = _opt(1020.0, positive=True, doc="rho")
+    conductivity_solid_W_mK: float = _opt(0.28, positive=True, doc="k_c")
+    conductivity_liquid_W_mK: float = _opt(0.24, positive=True, doc="k_m")
+    heat_capacity_solid_J_kgK: float = _opt(2700.0, positive=True, doc="c_c")
+    heat_capacity_liquid_J_kgK: float = _opt(2700.0, positive=True, doc="c_m")
+    latent_heat_J_kg: float = _opt(50e3, nonneg=True, doc="l_s")
+    melt_C: float = _opt(175.0, doc="T_m")
+    crystallization_C: float = _opt(146.0, doc="T_c (< T_m)")
+    expansion_solid_1_K: float = _opt(15e-5, doc="alpha for T <= T_c")
+    expansion_liquid_1_K: float = _opt(5e-5, doc="alpha for T >= T_m")
+    solidification_dilatation: float = _opt(
+        0.015, doc="beta: d(eps_m) = beta d(xi_s) 1 (eq. 37); 0.015 = the paper's 1.5 %"
+    )
+    poisson: float = _opt(0.42, doc="nu, in (-1, 0.5)")
+    youngs_solid_Pa: float = _opt(1e5, positive=True, doc="E for T <= T_c")
+    youngs_liquid_Pa: float = _opt(1e4, positive=True, doc="E for T >= T_m")
+    yield_solid_Pa: float = _opt(1e5, nonneg=True, doc="sigma_Y for T <= T_c")
+    yield_liquid_Pa: float = _opt(1e4, nonneg=True, doc="sigma_Y for T >= T_m")
+    hardening_solid_Pa: float = _opt(1e5, nonneg=True, doc="H for T <= T_c")
+    hardening_liquid_Pa: float = _opt(0.0, nonneg=True, doc="H for T >= T_m")
+    viscosity_model: str = _opt(
+        "exponential",
+        choices=("exponential", "constant"),
+        doc="exponential: eta = A exp(-b T[C]) (Table 3); constant: eta = viscosity_Pas",
+    )
+    viscosity_A_Pas: float = _opt(130219.0, positive=True, doc="A of the exponential law (Pa s)")
+    viscosity_b_1_C: float = _opt(0.02, nonneg=True, doc="b of the exponential law (1/C)")
+    viscosity_Pas: float = _opt(1e3, positive=True, doc="constant viscosity (Pa s)")
+    surface_tension_N_m: float = _opt(36.3e-3, nonneg=True, doc="gamma (N/m)")
+
+
+@dataclass
+class Wall:
+    mechanical: str = _opt(
+        "slip", choices=("slip", "stick", "open"), doc="slip: zero normal velocity"
+    )
+    thermal: str = _opt("insulated", choices=("insulated", "fixed"), doc="heat flux condition")
+    temperature_C: float = _opt(140.0, doc="wall temperature when thermal = fixed")
+
+
+def _bottom_wall() -> Wall:
+    return Wall(thermal="fixed")
+
+
+def _top_wall() -> Wall:
+    return Wall(mechanical="open")
+
+
+@dataclass
+class Boundary:
+    left: Wall = _opt(factory=Wall)
+    right: Wall = _opt(factory=Wall)
+    bottom: Wall = _opt(factory=_bottom_wall)
+    top: Wall = _opt(factory=_top_wall)
+
+
+@dataclass
+class Physics:
+    mechanics: bool = _opt(True, doc="move the points (off: frozen geometry, heat only)")
+    thermal: bool = _opt(True, doc="heat conduction and enthalpy")
+    surface_tension: bool = _opt(True, doc="CSF force (eqs. 19-24)")
+    plasticity: bool = _opt(True, doc="Perzyna return map (off: linear elastic)")
+    thermal_strain: bool = _opt(True, doc="thermal and transformation strains (eqs. 36-37)")
+    gravity_m_s2: list[float] = _opt(factory=lambda: [0.0, -9.81], doc="body force per mass")
+
+
+@dataclass
+class Time:
+    dt_s: float | str = _opt("auto", doc='time step (s), or "auto" from the stability limits')
+    end_s: float = _opt(1e-3, positive=True, doc="simulated end time (s)")
+    safety: float = _opt(0.4, positive=True, doc='fraction of the stability limit for "auto"')
+    allow_unstable_dt: bool = _opt(False, doc="let a fixed dt exceed the stability limit")
+
+
+@dataclass
+class Solver:
+    transfer: str = _opt(
+        "apic",
+        choices=("apic", "flip", "pic_flip"),
+        doc="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + (1-flip_ratio)*PIC",
+    )
+    flip_ratio: float = _opt(0.95, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
+    arch: str = _opt("cpu", choices=("cpu", "gpu"), doc="Taichi backend")
+    precision: str = _opt("f64", choices=("f64", "f32"), doc="floating point precision")
+    small_mass: float = _opt(
+        1e-9, nonneg=True, doc="nodes below this fraction of a full cell's mass are skipped"
+    )
+    optimize: bool = _opt(
+        True,
+        doc="full compiler optimisation (false: ~10x faster compile, ~1.6x slower steps)",
+    )
+    strain: str = _opt(
+        "small",
+        choices=("small",),
+        doc="small: accumulated eps += sym(L) dt (eqs. 16-17; not objective)",
+    )
+
+
+@dataclass
+class Thermal:
+    initial_C: float = _opt(140.0, doc="initial temperature of every body without its own")
+    enthalpy_reference_C: float = _opt(0.0, doc="temperature where enthalpy is zero")
+
+
+@dataclass
+class Laser:
+    power_W: float = _opt(25.0, nonneg=True, doc="P")
+    spot_radius_um: float = _opt(50.0, positive=True, doc="r_0")
+    absorptivity: float = _opt(0.85, nonneg=True, doc="A (fraction, MODEL.md reads 0.85 % as 0.85)")
+    penetration_depth_um: float = _opt(100.0, positive=True, doc="eta_l")
+    depth_factor: float = _opt(0.6, nonneg=True, doc="the 0.6 prefactor of eq. 31")
+    on_s: float = _opt(0.0, nonneg=True, doc="switch-on time (s)")
+    off_s: float = _opt(20e-6, nonneg=True, doc="switch-off time (s)")
+    x_start_um: float = _opt(40.0, doc="beam centre at on_s (um)")
+    speed_m_s: float = _opt(0.0, doc="scan speed along +x (m/s); 0 = stationary")
+    x_end_um: float | None = _opt(None, doc="beam switches off when its centre passes this x")
+    top_um: float | None = _opt(None, doc="y_l, top of the powder; default: highest body top")
+    depth_sign: str = _opt(
+        "decay",
+        choices=("decay", "paper"),
+        doc="decay: exp(-(y_l - y)/eta) (MODEL.md); paper: exp(+(y_l - y)/eta) as printed",
+    )
+
+
+@dataclass
+class SurfaceTension:
+    point_radius_over_h: float = _opt(
+        0.375, positive=True, doc="r_p / h in eq. 21; > sqrt(2)/4 so interior nodes read inside"
+    )
+    band_cells: int = _opt(3, positive=True, doc="half-width of the level-set band (cells)")
+    level_set: str = _opt(
+        "redistanced",
+        choices=("redistanced", "raw"),
+        doc="redistanced: signed distance to the eq. 21 zero contour; raw: eq. 21 as printed",
+    )
+    smoothing_passes: int = _opt(2, nonneg=True, doc="mass-weighted curvature smoothing passes")
+    curvature_cap_h: float = _opt(
+        0.5, nonneg=True, doc="|kappa| h capped here (0 = no cap); the grid resolves R >= 2h"
+    )
+
+
+@dataclass
+class Output:
+    frames: int = _opt(20, positive=True, doc="number of output frames over the run")
+    png: bool = _opt(True, doc="write frames/*.png")
+    gif: bool = _opt(True, doc="write animation.gif from the frames")
+    vtu: bool = _opt(False, doc="write ParaView point data (points_*.vtu + points.pvd)")
+    dpi: int = _opt(80, positive=True, doc="resolution of the frames")
+    deformation: str = _opt(
+        "displacement",
+        choices=("displacement", "plastic_strain"),
+        doc="what the right-hand panel colours the points by",
+    )
+
+
+@dataclass
+class Case:
+    case: CaseInfo = _opt(factory=CaseInfo)
+    grid: Grid = _opt(factory=Grid)
+    domain: Domain = _opt(factory=Domain)
+    bodies: list[Body] = _opt(factory=list)
+    materials: dict[str, Material] = _opt(factory=lambda: {"PA12": Material()})
+    boundary: Boundary = _opt(factory=Boundary)
+    physics: Physics = _opt(factory=Physics)
+    time: Time = _opt(factory=Time)
+    solver: Solver = _opt(factory=Solver)
+    thermal: Thermal = _opt(factory=Thermal)
+    lasers: list[Laser] = _opt(factory=list)
+    surface_tension: SurfaceTension = _opt(factory=SurfaceTension)
+    output: Output = _opt(factory=Output)
+
+
+# --------------------------------------------------------------------------- conversion
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(value: Any, tp: Any, key: str) -> Any:
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)):
+        if value is None and type(None) in args:
+            return None
+        errors = []
+        for a in args:
+            if a is type(None):
+                continue
+            try:
+                return _convert(value, a, key)
+            except CaseError as e:
+                errors.append(str(e))
+        allowed = " or ".join(_type_name(a) for a in args if a is not type(None))
+        raise CaseError(f"{key} = {value!r}: expected {allowed}")
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise CaseError(f"{key} = {value!r}: expected a table")
+        return _build(tp, value, key)
+    if origin is list:
+        if not isinstance(value, list):
+            raise CaseError(f"{key} = {value!r}: expected a list")
+        return [_convert(v, args[0], f"{key}[{i}]") for i, v in enumerate(value)]
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise CaseError(f"{key} = {value!r}: expected a table")
+        return {k: _convert(v, args[1], f"{key}.{k}") for k, v in value.items()}
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise CaseError(f"{key} = {value!r}: expected true or false")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise CaseError(f"{key} = {value!r}: expected an integer")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise CaseError(f"{key} = {value!r}: expected a number")
+        if not math.isfinite(value):
+            raise CaseError(f"{key} = {value!r}: expected a finite number")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise CaseError(f"{key} = {value!r}: expected a string")
+        return value
+    raise CaseError(f"{key}: unsupported type {tp}")  # pragma: no cover
+
+
+def _build(cls: type, data: dict, prefix: str) -> Any:
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        where = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
+        raise CaseError(f"unknown key {where!r}; allowed here: {', '.join(sorted(fields))}")
+    kwargs = {}
+    for name, value in data.items():
+        key = f"{prefix}.{name}" if prefix else name
+        f = fields[name]
+        v = _convert(value, hints[name], key)
+        meta = f.metadata
+        if meta.get("choices") and v not in meta["choices"]:
+            raise CaseError(f"{key} = {v!r}: allowed values are {', '.join(meta['choices'])}")
+        if meta.get("positive") and isinstance(v, (int, float)) and not v > 0:
+            raise CaseError(f"{key} = {v!r}: must be > 0")
+        if meta.get("nonneg") and isinstance(v, (int, float)) and not v >= 0:
+            raise CaseError(f"{key} = {v!r}: must be >= 0")
+        kwargs[name] = v
+    return cls(**kwargs)
+
+
+def _parse_override(text: str) -> tuple[list[str], Any]:
+    if "=" not in text:
+        raise CaseError(f"--set {text!r}: expected section.key=value")
+    path, raw = text.split("=", 1)
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw  # a bare word is a string: --set solver.transfer=flip
+    parts = path.strip().split(".")
+    return parts, value
+
+
+def apply_override(data: dict, text: str) -> None:
+    """Apply one ``section.key=value`` override to raw case data. List items: ``bodies.0.radius_um``
+    or ``lasers.0.power_W``."""
+    parts, value = _parse_override(text)
+    node: Any = data
+    for i, p in enumerate(parts[:-1]):
+        if isinstance(node, list):
+            if not p.isdigit() or int(p) >= len(node):
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is no list index")
+            node = node[int(p)]
+        else:
+            node = node.setdefault(p, {})
+            if not isinstance(node, (dict, list)):
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is not a table")
+    last = parts[-1]
+    if isinstance(node, list):
+        if not last.isdigit() or int(last) >= len(node):
+            raise CaseError(f"--set {text!r}: {last!r} is no list index")
+        node[int(last)] = value
+    else:
+        node[last] = value
+
+
+def case_from_dict(data: dict) -> Case:
+    """Build and validate a :class:`Case` from raw TOML data."""
+    case = _build(Case, data, "")
+    validate(case)
+    return case
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
+    """Read a case file, apply ``--set`` overrides, validate, return the :class:`Case`."""
+    path = Path(path)
+    if not path.is_file():
+        raise CaseError(f"case file {str(path)!r} does not exist")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise CaseError(f"{path}: not valid TOML: {e}") from None
+    for o in overrides or []:
+        apply_override(data, o)
+    if "case" not in data or "name" not in data.get("case", {}):
+        data.setdefault("case", {})["name"] = path.stem
+    return case_from_dict(data)
+
+
+def _check_pair(key: str, v: list[float]) -> None:
+    if len(v) != 2:
+        raise CaseError(f"{key} = {v!r}: expected two numbers [x, y]")
+
+
+def validate(case: Case) -> None:
+    """Cross-field checks that a field type alone cannot express."""
+    W, Hh = case.domain.width_um, case.domain.height_um
+    h = case.grid.spacing_um
+    if h > min(W, Hh) / 2:
+        raise CaseError(f"grid.spacing_um = {h}: must be at most half the smaller domain side")
+    if not case.bodies:
+        raise CaseError("bodies: at least one [[bodies]] table is required")
+    for name, m in case.materials.items():
+        key = f"materials.{name}"
+        if not -1.0 < m.poisson < 0.5:
+            raise CaseError(f"{key}.poisson = {m.poisson}: must lie in (-1, 0.5)")
+        if not m.crystallization_C < m.melt_C:
+            raise CaseError(
+                f"{key}.crystallization_C = {m.crystallization_C}: must be below "
+                f"melt_C = {m.melt_C}"
+            )
+    eps = 1e-9 * max(W, Hh)
+    for i, b in enumerate(case.bodies):
+        key = f"bodies[{i}]"
+        if b.material not in case.materials:
+            raise CaseError(
+                f"{key}.material = {b.material!r}: no such material; defined: "
+                f"{', '.join(case.materials)}"
+            )
+        _check_pair(f"{key}.velocity_m_s", b.velocity_m_s)
+        if b.shape == "disc":
+            _check_pair(f"{key}.center_um", b.center_um)
+            (cx, cy), r = b.center_um, b.radius_um
+            lo, hi = (cx - r, cy - r), (cx + r, cy + r)
+        else:
+            _check_pair(f"{key}.min_um", b.min_um)
+            _check_pair(f"{key}.max_um", b.max_um)
+            lo, hi = tuple(b.min_um), tuple(b.max_um)
+            if not (hi[0] > lo[0] and hi[1] > lo[1]):
+                raise CaseError(f"{key}.max_um = {b.max_um}: must exceed min_um = {b.min_um}")
+        if lo[0] < -eps or lo[1] < -eps or hi[0] > W + eps or hi[1] > Hh + eps:
+            raise CaseError(
+                f"{key}: extent x {lo[0]}..{hi[0]}, y {lo[1]}..{hi[1]} um lies outside the "
+                f"domain 0..{W} x 0..{Hh} um"
+            )
+    _check_pair("physics.gravity_m_s2", case.physics.gravity_m_s2)
+    dt = case.time.dt_s
+    if isinstance(dt, str) and dt != "auto":
+        raise CaseError(f'time.dt_s = {dt!r}: expected a positive number or "auto"')
+    if isinstance(dt, float) and not dt > 0:
+        raise CaseError(f"time.dt_s = {dt}: must be > 0")
+    if not 0 <= case.solver.flip_ratio <= 1:
+        raise CaseError(f"solver.flip_ratio = {case.solver.flip_ratio}: must lie in [0, 1]")
+    for i, las in enumerate(case.lasers):
+        if las.off_s < las.on_s:
+            raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+    if case.surface_tension.point_radius_over_h <= math.sqrt(2) / 4:
+        raise CaseError(
+            f"surface_tension.point_radius_over_h = {case.surface_tension.point_radius_over_h}: "
+            f"must exceed sqrt(2)/4 = {math.sqrt(2) / 4:.4f} (interior nodes would read outside)"
+        )
+
+
+def case_to_dict(case: Case) -> dict:
+    """The resolved case as plain data (None values dropped: TOML has no null)."""
+
+    def clean(x: Any) -> Any:
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items() if v is not None}
+        if isinstance(x, list):
+            return [clean(v) for v in x]
+        return x
+
+    return clean(dataclasses.asdict(case))
+
+
+def to_toml(data: dict) -> str:
+    """Minimal TOML writer for resolved cases (tables, arrays of tables, scalars, lists)."""
+    lines: list[str] = []
+
+    def scalar(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (int, float)):
+            return repr(v)
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, list):
+            return "[" + ", ".join(scalar(x) for x in v) + "]"
+        raise TypeError(v)
+
+    def table(prefix: str, d: dict, array: bool = False) -> None:
+        simple = {k: v for k, v in d.items() if not isinstance(v, dict) and not _is_tables(v)}
+        nested = {k: v for k, v in d.items() if k not in simple}
+        if prefix:
+            lines.append(f"[[{prefix}]]" if array else f"[{prefix}]")
+        for k, v in simple.items():
+            lines.append(f"{k} = {scalar(v)}")
+        lines.append("")
+        for k, v in nested.items():
+            sub = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, dict):
+                table(sub, v)
+            else:
+                for item in v:
+                    table(sub, item, array=True)
+
+    table("", data)
+    return "\n".join(lines)
+
+
+def _is_tables(v: Any) -> bool:
+    return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+
+def describe_keys() -> str:
+    """Markdown reference of every key, its default and its meaning (docs/case_reference.md)."""
+    out = ["# Case file reference", "", "Generated by `python -m taichi_sls.case`.", ""]
+    sections = [
+        ("case", CaseInfo),
+        ("grid", Grid),
+        ("domain", Domain),
+        ("[[bodies]]", Body),
+        ("materials.NAME", Material),
+        ("boundary.left / right / bottom / top", Wall),
+        ("physics", Physics),
+        ("time", Time),
+        ("solver", Solver),
+        ("thermal", Thermal),
+        ("[[lasers]]", Laser),
+        ("surface_tension", SurfaceTension),
+        ("output", Output),
+    ]
+    for title, cls in sections:
+        out += [f"## `{title}`", ""]
+        if cls.__doc__ and not cls.__doc__.startswith(cls.__name__ + "("):
+            out += [" ".join(cls.__doc__.split()), ""]
+        out += ["| key | default | meaning |", "|---|---|---|"]
+        for f in dataclasses.fields(cls):
+            if f.default is not dataclasses.MISSING:
+                d = f.default
+            elif f.default_factory is not dataclasses.MISSING:
+                d = f.default_factory()
+            else:
+                d = ""
+            meta = f.metadata
+            doc = meta.get("doc", "")
+            if meta.get("choices"):
+                doc += f" (one of: {', '.join(meta['choices'])})"
+            out.append(f"| `{f.name}` | `{d!r}` | {doc} |")
+        out.append("")
+    out.append(
+        'Bottom wall default: `thermal = "fixed"` at 140 C; top wall default: '
+        '`mechanical = "open"`.'
+    )
+    return "\n".join(out) + "\n"
+
+
+if __name__ == "__main__":
+    print(describe_keys(), end="")

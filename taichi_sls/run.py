@@ -1,0 +1,178 @@
+"""The main job: ``python -m taichi_sls.run CASE.toml [--out DIR] [--set key=value ...]``.
+
+Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``animation.gif``,
+``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``summary.json``, the resolved
+``case.toml`` and, with ``output.vtu = true``, ParaView point data. Every file is written
+atomically; an interrupted or failed run still leaves valid files and a summary that says so.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from .case import Case, CaseError, case_to_dict, load_case, to_toml
+
+
+def _progress(total_steps: int, dt: float):
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a dependency
+        return None
+    return tqdm(
+        total=total_steps,
+        unit="step",
+        unit_scale=True,
+        dynamic_ncols=True,
+        desc="t = 0 us",
+        file=sys.stderr,
+        mininterval=0.5,
+    )
+
+
+def run_case(
+    case: Case,
+    out_dir: Path,
+    *,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Run one case to its end time, writing every output. Returns the summary."""
+    from .output import OutputWriter
+    from .simulation import Simulation, SimulationError
+
+    wall0 = time.perf_counter()
+    sim = Simulation(case)
+    sc = sim.scene
+    o = case.output
+    writer = OutputWriter(
+        out_dir,
+        domain_um=(
+            -case.grid.ghost_cells * case.grid.spacing_um,
+            case.domain.width_um + case.grid.ghost_cells * case.grid.spacing_um,
+            -case.grid.ghost_cells * case.grid.spacing_um,
+            case.domain.height_um,
+        ),
+        melt_C=min(m.melt_C for m in case.materials.values()),
+        png=o.png,
+        gif=o.gif,
+        vtu=o.vtu,
+        dpi=o.dpi,
+        deformation=o.deformation,
+    )
+    writer.write_case(to_toml(case_to_dict(case)))
+    n_frames = o.frames
+    steps_per_frame = max(1, int(round(case.time.end_s / n_frames / sim.dt)))
+    total = steps_per_frame * n_frames
+    print(
+        f"{case.case.name}: {sc.n_points} points, {sc.table1_nodes} nodes "
+        f"(domain + ghost layer; {sc.nx * sc.ny} in the arrays), dt = {sim.dt:.3g} s, "
+        f"{total} steps, compile {sim.compile_s:.1f} s",
+        file=sys.stderr,
+    )
+    summary: dict[str, Any] = {
+        "case": case.case.name,
+        "status": "running",
+        "points": sc.n_points,
+        "nodes": sc.table1_nodes,
+        "nodes_in_arrays": sc.nx * sc.ny,
+        "dt_s": sim.dt,
+        "dt_limits_s": sim.dt_limits,
+        "compile_s": sim.compile_s,
+    }
+
+    def frame(index: int) -> dict[str, float]:
+        mon = sim.monitors()
+        writer.row(mon)
+        snap = sim.snapshot()
+        deform = snap["displacement_um" if o.deformation == "displacement" else "plastic_strain"]
+        writer.frame(index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"])
+        return mon
+
+    first = frame(0)
+    summary["initial"] = first
+    last = first
+    bar = _progress(total, sim.dt) if progress else None
+    step_wall = 0.0
+    chunk = max(1, min(steps_per_frame, 2000))
+    try:
+        for k in range(1, n_frames + 1):
+            done = 0
+            while done < steps_per_frame:
+                n = min(chunk, steps_per_frame - done)
+                t0 = time.perf_counter()
+                sim.advance(n)
+                step_wall += time.perf_counter() - t0
+                done += n
+                if bar is not None:
+                    bar.update(n)
+                    sps = sim.steps / step_wall if step_wall > 0 else 0.0
+                    bar.set_description(f"t = {sim.t * 1e6:.1f} us, {sps:,.0f} steps/s")
+            last = frame(k)
+        summary["status"] = "complete"
+    except SimulationError as e:
+        summary["status"] = "failed"
+        summary["error"] = str(e)
+    except KeyboardInterrupt:
+        summary["status"] = "interrupted"
+    finally:
+        if bar is not None:
+            bar.close()
+        summary.update(
+            steps=sim.steps,
+            simulated_s=sim.t,
+            wall_s=time.perf_counter() - wall0,
+            step_wall_s=step_wall,
+            steps_per_s=sim.steps / step_wall if step_wall > 0 else math.nan,
+            final=last,
+            T_peak_C=last.get("T_peak_C"),
+        )
+        writer.summary(summary)
+        writer.finish()
+    return summary
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m taichi_sls.run", description="Run a taichi_sls case file."
+    )
+    ap.add_argument("case", help="case file (TOML)")
+    ap.add_argument("--out", help="output folder (default: out/<case name>)")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a case key, e.g. --set lasers.0.power_W=15 --set time.end_s=1e-4",
+    )
+    ap.add_argument("--no-progress", action="store_true", help="no progress bar")
+    args = ap.parse_args(argv)
+    try:
+        case = load_case(args.case, args.set)
+        from .simulation import resolve_dt
+
+        resolve_dt(case)  # refuse an unstable fixed dt before any work
+    except CaseError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    out = Path(args.out) if args.out else Path("out") / case.case.name
+    summary = run_case(case, out, progress=not args.no_progress)
+    fin = summary["final"]
+    print(
+        f"{summary['status']}: {summary['steps']} steps, {summary['simulated_s'] * 1e3:.3g} ms "
+        f"simulated in {summary['step_wall_s']:.1f} s ({summary['steps_per_s']:,.0f} steps/s; "
+        f"compile {summary['compile_s']:.1f} s); peak T {fin['T_peak_C']:.1f} C, contact line "
+        f"{fin['contact_line_um']:.2f} um -> {out}",
+        file=sys.stderr,
+    )
+    if summary["status"] == "failed":
+        print(f"error: {summary['error']}", file=sys.stderr)
+        return 1
+    return 0 if summary["status"] == "complete" else 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

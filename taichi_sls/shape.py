@@ -1,0 +1,75 @@
+"""uGIMP shape functions (Bardenhagen & Kober 2004) on a 3x3 node stencil.
+
+A point of half-width l_p (uGIMP: l_p = h/4 for 2x2 points per cell) interacts with the nodes
+closer than h + l_p. With node spacing h that is at most three nodes per axis, starting at
+``base = round(x/h) - 1`` (eqs. 8-9 with N_i the uGIMP function).
+"""
+
+import taichi as ti
+
+# Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
+# surface tension and output are 2D (plane strain) for now.
+DIM = 2
+# The 3^DIM node offsets of the stencil, for `for o in ti.static(ti.grouped(STENCIL))`.
+STENCIL = ti.ndrange(*((3,) * DIM))
+
+
+@ti.func
+def gimp_1d(xi, h, lp):
+    """Weight S and its derivative dS/dx_p for a point at signed distance xi = x_p - x_i."""
+    a = ti.abs(xi)
+    s = 0.0 * xi
+    ds = 0.0 * xi
+    sgn = 1.0 if xi >= 0 else -1.0
+    if a < lp:
+        s = 1.0 - (xi * xi + lp * lp) / (2.0 * h * lp)
+        ds = -xi / (h * lp)
+    elif a < h - lp:
+        s = 1.0 - a / h
+        ds = -sgn / h
+    elif a < h + lp:
+        r = h + lp - a
+        s = r * r / (4.0 * h * lp)
+        ds = -sgn * r / (2.0 * h * lp)
+    return s, ds
+
+
+@ti.func
+def stencil(xp, inv_h, h, lp, origin_idx):
+    """Base node index and the 3x3 tensor-product weights / gradients for point position xp.
+
+    Returns (base, w, dw) where w[a][d] is the weight of node base+a along axis d and dw its
+    derivative; node (a, b) has N = w[a][0] * w[b][1] and grad N = (dw[a][0] w[b][1],
+    w[a][0] dw[b][1]). Positions are physical; origin_idx is the index of the node at x = 0.
+    """
+    dim = ti.static(xp.n)
+    base = ti.Vector.zero(ti.i32, dim)
+    w = ti.Matrix.zero(float, 3, dim)
+    dw = ti.Matrix.zero(float, 3, dim)
+    for d in ti.static(range(dim)):
+        f = xp[d] * inv_h
+        base[d] = ti.cast(ti.floor(f + 0.5), ti.i32) - 1
+        for a in ti.static(range(3)):
+            xi = (f - ti.cast(base[d] + a, float)) * h
+            s, ds = gimp_1d(xi, h, lp)
+            w[a, d] = s
+            dw[a, d] = ds
+        base[d] += origin_idx
+    return base, w, dw
+
+
+@ti.func
+def node_weight(w, dw, offs):
+    """N and grad N of the stencil node at static offset ``offs`` (tensor product, any dim)."""
+    dim = ti.static(w.m)
+    n = 1.0 + 0.0 * w[0, 0]
+    g = ti.Vector.zero(float, dim)
+    for d in ti.static(range(dim)):
+        n *= w[offs[d], d]
+    for d in ti.static(range(dim)):
+        gd = dw[offs[d], d]
+        for e in ti.static(range(dim)):
+            if ti.static(e != d):
+                gd *= w[offs[e], e]
+        g[d] = gd
+    return n, g
