@@ -352,6 +352,8 @@ def apply_override(data: dict, text: str) -> None:
                 raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is no list index")
             node = node[int(p)]
         else:
+            if p not in node and parts[i + 1].isdigit():
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is no list")
             node = node.setdefault(p, {})
             if not isinstance(node, (dict, list)):
                 raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is not a table")

@@ -52,6 +52,7 @@ class State:
         self.wall_mech = tuple(WALL_MECH[w.mechanical] for w in (b.left, b.right, b.bottom, b.top))
         self.wall_fixed = tuple(w.thermal == "fixed" for w in (b.left, b.right, b.bottom, b.top))
         self.wall_T = tuple(w.temperature_C + KELVIN for w in (b.left, b.right, b.bottom, b.top))
+        self.any_fixed = self.thermal and any(self.wall_fixed)
 
         st = case.surface_tension
         self.r_p = st.point_radius_over_h * scene.h

@@ -8,14 +8,21 @@ sign of MODEL.md, eq. 30's laser term with eq. 31 read as W/m^3); dT_i = dt Q_i 
 gains enthalpy dH_p = c_p sum N_ip dT_i. Since sum_p M_p c_p N_ip / c_i = 1 this moves exactly the
 grid's heat to the points: the energy balance holds to round-off.
 
-Fixed-temperature walls: their nodes enter the gradient at the wall temperature, pass no
-increment to the points (so no point is pushed past the wall temperature, MODEL.md), and the heat
-that reaches them leaves the body and is counted in ``heat_out``.
+Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
+increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
+to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
+(MODEL.md: resetting the nodes by increments drove points beside the plate to 110 C).
 """
 
 import taichi as ti
 
-from .materials import apparent_heat_capacity, lerp_phase, solid_fraction, temperature_from_enthalpy
+from .materials import (
+    apparent_heat_capacity,
+    enthalpy,
+    lerp_phase,
+    solid_fraction,
+    temperature_from_enthalpy,
+)
 from .shape import STENCIL, node_weight
 from .state import LP
 
@@ -113,15 +120,37 @@ def grid_heat(st: ti.template(), I, dt):
 
 @ti.func
 def g2p_heat(st: ti.template(), p, base, w, dw):
-    """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains."""
+    """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains.
+
+    Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
+    transfer). A point within the support of a fixed node takes the interpolated grid temperature
+    sum N T_i^{n+1} instead (T_i = the wall temperature there): a convex combination of node
+    temperatures, so it can never pass the wall temperature (MODEL.md), and second-order accurate
+    next to the wall where increments alone would lag. What that changes in its enthalpy beyond
+    the FLIP increment is heat exchanged with the wall and is booked in heat_out.
+    """
     dTg = 0.0
+    T_pic = 0.0
+    w_fixed = 0.0
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
-        dTg += N * st.gdT[base + o]
+        I = base + o
+        dTg += N * st.gdT[I]
+        if ti.static(st.any_fixed):
+            T_pic += N * (st.gT[I] + st.gdT[I])
+            fixed, Tw = fixed_temperature(st, I)
+            if fixed:
+                w_fixed += N
     m = st.mat[p]
     T0 = st.T[p]
     xi0 = st.xi[p]
-    st.H[p] += apparent_heat_capacity(st.matp, m, T0) * dTg
+    dH = apparent_heat_capacity(st.matp, m, T0) * dTg
+    if ti.static(st.any_fixed):
+        if w_fixed > 0.0:
+            H_pic = enthalpy(st.matp, m, T_pic)
+            st.heat_out[None] -= st.mass[p] * (H_pic - st.H[p] - dH)
+            dH = H_pic - st.H[p]
+    st.H[p] += dH
     T1 = temperature_from_enthalpy(st.matp, m, st.H[p])
     xi1 = solid_fraction(st.matp, m, T1)
     st.T[p] = T1
