@@ -213,7 +213,12 @@ class SurfaceTension:
         choices=("redistanced", "raw"),
         doc="redistanced: signed distance to the eq. 21 zero contour; raw: eq. 21 as printed",
     )
-    smoothing_passes: int = _opt(2, nonneg=True, doc="mass-weighted curvature smoothing passes")
+    level_set_smoothing_passes: int = _opt(
+        8, nonneg=True, doc="binomial smoothing passes over phi before the curvature fit"
+    )
+    smoothing_passes: int = _opt(
+        16, nonneg=True, doc="mass-weighted curvature smoothing passes over interface nodes"
+    )
     curvature_cap_h: float = _opt(
         0.5, nonneg=True, doc="|kappa| h capped here (0 = no cap); the grid resolves R >= 2h"
     )

@@ -59,6 +59,7 @@ class State:
         self.band = st.band_cells
         self.redistance = st.level_set == "redistanced"
         self.smooth_passes = st.smoothing_passes
+        self.blur_passes = st.level_set_smoothing_passes
         self.kappa_cap = st.curvature_cap_h / scene.h if st.curvature_cap_h > 0 else 0.0
         self.phi_cap = (st.band_cells + 1) * scene.h
 
@@ -103,6 +104,7 @@ class State:
         self.gdT = ti.field(float, gs)
         self.phi_raw = ti.field(float, gs)  # eq. 21
         self.phi = ti.field(float, gs)  # signed distance in the band
+        self.phis = ti.field(float, gs)  # phi smoothed for the curvature fit
         self.kappa = ti.field(float, gs)
         self.ktmp = ti.field(float, gs)
         self.kvalid = ti.field(ti.i32, gs)

@@ -163,3 +163,12 @@ def advance(st: State, n: int, gpu: bool) -> None:
             advance_one(st)
     else:
         advance_serial(st, n)
+
+
+@ti.kernel
+def surface_only(st: ti.template()):
+    """Grid mass, level set, curvature and CSF force of the current points, without a step
+    (diagnostics and verification)."""
+    clear_grid(st)
+    p2g(st)
+    surface_forces(st)
