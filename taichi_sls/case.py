@@ -219,6 +219,9 @@ class SurfaceTension:
     smoothing_passes: int = _opt(
         16, nonneg=True, doc="mass-weighted curvature smoothing passes over interface nodes"
     )
+    zero_net_force: bool = _opt(
+        True, doc="remove the CSF resultant left by curvature noise (mass-weighted)"
+    )
     curvature_cap_h: float = _opt(
         0.5, nonneg=True, doc="|kappa| h capped here (0 = no cap); the grid resolves R >= 2h"
     )

@@ -60,6 +60,7 @@ class State:
         self.redistance = st.level_set == "redistanced"
         self.smooth_passes = st.smoothing_passes
         self.blur_passes = st.level_set_smoothing_passes
+        self.zero_net_force = st.zero_net_force
         self.kappa_cap = st.curvature_cap_h / scene.h if st.curvature_cap_h > 0 else 0.0
         self.phi_cap = (st.band_cells + 1) * scene.h
 
@@ -122,6 +123,7 @@ class State:
         self.lasp = ti.field(float, (max(self.n_lasers, 1), len(LASER_PARAMS)))
         self.fit = ti.Matrix.field(6, 9, float, ())  # least-squares fit of eq. 23
         self.red = ti.field(float, 8)  # reductions for monitors
+        self.red_f = ti.Vector.field(3, float, ())  # CSF resultant and interface mass
         self._vec, self._mat2, self._mat3 = vec, mat2, mat3
         self._fill()
 
