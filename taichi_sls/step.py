@@ -27,7 +27,12 @@ from .thermal import g2p_heat, grid_heat, grid_temperature, p2g_heat_capacity, p
 
 @ti.func
 def _stencil(st: ti.template(), p):
-    return stencil(st.x[p], st.inv_h, st.h, st.lp, st.off)
+    base, w, dw = stencil(st.x[p], st.inv_h, st.h, st.lp, st.off)
+    # A point that has left the grid (or become NaN) must not write outside the arrays: clamp
+    # its stencil; the guard reports it at the next frame. The 2-cell padding keeps every point
+    # of a healthy run far from this bound.
+    base = ti.max(ti.min(base, ti.Vector([st.nx - 4, st.ny - 4])), 1)
+    return base, w, dw
 
 
 @ti.func

@@ -1,0 +1,79 @@
+"""The main job end to end: every output file, f32, and a run that the guard stops."""
+
+import csv
+import json
+from pathlib import Path
+
+import imageio.v3 as iio
+import meshio
+import numpy as np
+from conftest import PAPER_SCENE, deep_update, make_case
+
+from taichi_sls.case import describe_keys
+from taichi_sls.run import run_case
+from taichi_sls.simulation import Simulation
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _small(extra: dict | None = None):
+    base = deep_update(
+        PAPER_SCENE,
+        {
+            "case": {"name": "small"},
+            "grid": {"spacing_um": 4.0},
+            "time": {"end_s": 2e-5},
+            "lasers": [{"power_W": 25.0}],
+            "output": {"frames": 3, "vtu": True, "dpi": 50},
+        },
+    )
+    return make_case(deep_update(base, extra or {}))
+
+
+def test_main_job_writes_every_output(tmp_path):
+    out = tmp_path / "run"
+    summary = run_case(_small(), out, progress=False)
+    assert summary["status"] == "complete"
+    for name in ("case.toml", "timeseries.csv", "summary.json", "animation.gif", "points.pvd"):
+        assert (out / name).is_file(), name
+    frames = sorted((out / "frames").glob("frame_*.png"))
+    assert len(frames) == 4  # the initial state and 3 frames
+    assert iio.imread(frames[-1]).shape[2] in (3, 4)
+    rows = list(csv.DictReader((out / "timeseries.csv").open()))
+    assert len(rows) == 4
+    for col in ("t_s", "T_max_C", "contact_line_um", "kinetic_energy_J_per_m", "J_min"):
+        assert col in rows[0]
+    s = json.loads((out / "summary.json").read_text())
+    for key in ("case", "steps", "simulated_s", "wall_s", "compile_s", "steps_per_s", "points"):
+        assert key in s
+    assert s["nodes"] == 322 and s["points"] == 632
+    assert s["final"]["T_max_C"] > s["initial"]["T_max_C"]
+    assert abs(s["simulated_s"] - 2e-5) < 1e-6
+    mesh = meshio.read(sorted((out / "vtu").glob("*.vtu"))[-1])
+    assert len(mesh.points) == 632 and "T_C" in mesh.point_data
+
+
+def test_single_precision_runs():
+    sim = Simulation(_small({"solver": {"precision": "f32"}}))
+    H0 = sim.monitors()["enthalpy_J_per_m"]
+    sim.advance(100)
+    m = sim.monitors()
+    assert np.isfinite(m["T_max_C"]) and m["T_max_C"] > 140.0
+    bal = m["enthalpy_J_per_m"] - H0 + m["heat_out_J_per_m"] - m["laser_energy_J_per_m"]
+    assert abs(bal) < 1e-4 * m["laser_energy_J_per_m"]  # f32 round-off
+
+
+def test_guard_stops_a_blow_up_and_keeps_the_outputs(tmp_path):
+    out = tmp_path / "bad"
+    case = _small({"time": {"dt_s": 2e-6, "allow_unstable_dt": True, "end_s": 4e-4}})
+    summary = run_case(case, out, progress=False)
+    assert summary["status"] == "failed"
+    assert "likely cause: time step" in summary["error"]
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "failed"
+    rows = list(csv.DictReader((out / "timeseries.csv").open()))
+    assert len(rows) >= 1  # the frames before the trip are kept
+
+
+def test_case_reference_is_current():
+    assert (ROOT / "docs" / "case_reference.md").read_text() == describe_keys()
