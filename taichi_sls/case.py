@@ -165,6 +165,12 @@ class Solver:
     small_mass: float = _opt(
         1e-9, nonneg=True, doc="nodes below this fraction of a full cell's mass are skipped"
     )
+    stress_reading: str = _opt(
+        "model",
+        choices=("model", "paper"),
+        doc="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md); paper: eq. 39 and "
+        "p = lambda tr(eps) as printed",
+    )
     optimize: bool = _opt(
         True,
         doc="full compiler optimisation (false: ~10x faster compile, ~1.6x slower steps)",
@@ -195,6 +201,11 @@ class Laser:
     speed_m_s: float = _opt(0.0, doc="scan speed along +x (m/s); 0 = stationary")
     x_end_um: float | None = _opt(None, doc="beam switches off when its centre passes this x")
     top_um: float | None = _opt(None, doc="y_l, top of the powder; default: highest body top")
+    source_units: str = _opt(
+        "W_per_m3",
+        choices=("W_per_m3", "W_per_kg"),
+        doc="eq. 31 read as W/m^3 (MODEL.md) or, as printed in eq. 3, W/kg multiplied by rho",
+    )
     depth_sign: str = _opt(
         "decay",
         choices=("decay", "paper"),

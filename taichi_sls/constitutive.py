@@ -36,8 +36,10 @@ def perzyna_update(
     T,
     dt,
     plastic: ti.template(),
+    paper: ti.template(),
 ):
-    """One backward-Euler Perzyna step. Returns (sigma, eps_pl, alpha).
+    """One backward-Euler Perzyna step. Returns (sigma, eps_pl, alpha). ``paper`` selects the
+    printed eq. 39 and pressure instead of MODEL.md's reading.
 
     Trial: s_tr = 2 mu dev(eps_e), f = |s_tr| - sqrt(2/3)(sigma_Y + H alpha) (eq. 40); when f > 0,
     dgamma = (f / 2mu) / (tau/dt + 1 + H/(3 mu)), tau = eta / (2 mu) (eq. 41), and the plastic
@@ -51,6 +53,11 @@ def perzyna_update(
     ee = eps3 - eps_pl - e_iso * I3
     tr = ee.trace()
     s = 2.0 * mu * (ee - tr / 3.0 * I3)
+    p = K * tr
+    if ti.static(paper):
+        # eq. 39 as printed (the trace term without its 2 mu) and p = lambda tr(eps_{n+1})
+        s = 2.0 * mu * ee - tr / 3.0 * I3
+        p = (K - 2.0 * mu / 3.0) * eps3.trace()
     if ti.static(plastic):
         sy = lerp_phase(mat, m, xi, "sy_c", "sy_m")
         Hh = lerp_phase(mat, m, xi, "H_c", "H_m")
@@ -63,4 +70,4 @@ def perzyna_update(
             eps_pl += dgam * n
             alpha += SQRT23 * dgam
             s -= 2.0 * mu * dgam * n
-    return K * tr * I3 + s, eps_pl, alpha
+    return p * I3 + s, eps_pl, alpha

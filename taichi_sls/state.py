@@ -41,6 +41,7 @@ class State:
         self.thermal = ph.thermal
         self.surface = ph.surface_tension and ph.mechanics
         self.plastic = ph.plasticity
+        self.paper_stress = case.solver.stress_reading == "paper"
         self.th_strain = ph.thermal_strain and ph.thermal
         self.gravity = tuple(ph.gravity_m_s2)
         self.has_gravity = any(g != 0.0 for g in self.gravity)
@@ -191,6 +192,8 @@ def _laser_rows(case: Case, sc: Scene) -> np.ndarray:
         eta = las.penetration_depth_um * 1e-6
         # eq. 31 read as power per unit volume (W/m^3), MODEL.md
         amp = 2 * las.absorptivity * las.power_W / (math.pi * r0 * r0 * eta) * las.depth_factor
+        if las.source_units == "W_per_kg":  # eq. 3 as printed: rho * s_laser
+            amp *= case.materials[case.bodies[0].material].density_kg_m3
         x_end = las.x_end_um if las.x_end_um is not None else 1e9
         y_top = las.top_um if las.top_um is not None else top
         vals = dict(

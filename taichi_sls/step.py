@@ -115,6 +115,7 @@ def g2p(st: ti.template(), dt):
                 st.T[p],
                 dt,
                 st.plastic,
+                st.paper_stress,
             )
             st.sigma[p] = sig
             st.eps_pl[p] = epl

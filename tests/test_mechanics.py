@@ -176,7 +176,7 @@ def _perzyna_history(strains: np.ndarray, dt: float) -> tuple[np.ndarray, np.nda
             for k in range(n):
                 eps = ti.Matrix([[0.0, e[k]], [e[k], 0.0]])
                 sig, epl2, a2 = perzyna_update(
-                    mat, 0, embed3(eps), epl, a, 0.0, 1.0, 300.0, dt, True
+                    mat, 0, embed3(eps), epl, a, 0.0, 1.0, 300.0, dt, True, False
                 )
                 epl = epl2
                 a = a2
@@ -227,3 +227,29 @@ def test_perzyna_relaxation_ratio_is_exact():
     r = f[n_load:] / f[n_load - 1 : -1]
     expected = ref.perzyna_relaxation_ratio(dt, eta / (2 * mu), mu, H)
     np.testing.assert_allclose(r, expected, rtol=1e-9)
+
+
+def test_paper_stress_reading_is_reachable():
+    """solver.stress_reading = "paper": eq. 39 as printed and p = lambda tr(eps)."""
+    init_taichi(optimize=False)
+    mat = ti.field(float, (1, len(material_row(MU_MAT, 0.0))))
+    mat.from_numpy(material_row(MU_MAT, 0.0)[None, :])
+    out = ti.Matrix.field(3, 3, float, 2)
+
+    @ti.kernel
+    def stress(exx: float, eyy: float):
+        e = embed3(ti.Matrix([[exx, 0.0], [0.0, eyy]]))
+        z = ti.Matrix.zero(float, 3, 3)
+        out[0] = perzyna_update(mat, 0, e, z, 0.0, 0.0, 1.0, 300.0, 1e-3, False, False)[0]
+        out[1] = perzyna_update(mat, 0, e, z, 0.0, 0.0, 1.0, 300.0, 1e-3, False, True)[0]
+
+    exx, eyy = 1e-3, -4e-4
+    stress(exx, eyy)
+    model, paper = out.to_numpy()
+    E, nu = MU_MAT.youngs_solid_Pa, MU_MAT.poisson
+    mu, lam = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    e = np.diag([exx, eyy, 0.0])
+    tr = np.trace(e)
+    # plane-strain Hooke's law for the model reading
+    np.testing.assert_allclose(model, lam * tr * np.eye(3) + 2 * mu * e, rtol=1e-12)
+    np.testing.assert_allclose(paper, lam * tr * np.eye(3) + 2 * mu * e - tr / 3 * np.eye(3))

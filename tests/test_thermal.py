@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 from conftest import PAPER_SCENE, deep_update, make_case
 
 from taichi_sls import references as ref
@@ -171,3 +172,17 @@ def test_free_thermal_expansion_is_stress_free():
     in_plane = np.abs(sig[:, :2, :2]).max()
     # residual stress from the 0.2 % non-uniform heating and inertia: < 2 % of E alpha dT
     assert in_plane < 0.02 * E * a * dT
+
+
+def test_laser_per_kg_reading_is_rho_times_larger():
+    """lasers.source_units = "W_per_kg" (eq. 3 as printed) delivers rho times the energy."""
+    out = []
+    for units in ("W_per_m3", "W_per_kg"):
+        case = _laser_case(False)
+        case.lasers[0].source_units = units
+        case.lasers[0].power_W = 0.01
+        case.physics.mechanics = False  # frozen points: same volumes in both runs
+        sim = Simulation(case)
+        sim.advance(20)
+        out.append(sim.monitors()["laser_energy_J_per_m"])
+    assert out[1] / out[0] == pytest.approx(RHO, rel=1e-9)
