@@ -297,6 +297,17 @@ class OutputWriter:
             w.writerow(cells + [""] * (n - len(cells)))
         atomic_write_text(self.out_dir / "timeseries.csv", buf.getvalue())
 
+    def resume(self) -> None:
+        """Continue an existing output folder: keep its time series rows and frames."""
+        path = self.out_dir / "timeseries.csv"
+        if path.is_file():
+            rows = list(csv.reader(path.open()))
+            if rows:
+                self._header = rows[0]
+                self._lines = rows[1:]
+        for p in sorted((self.out_dir / "frames").glob("frame_*.png")):
+            self._png_paths[int(p.stem.split("_")[1])] = p
+
     # ----------------------------------------------------------------- frames
 
     def frame(

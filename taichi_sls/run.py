@@ -9,7 +9,9 @@ atomically; an interrupted or failed run still leaves valid files and a summary 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import signal
 import sys
 import time
 from pathlib import Path
@@ -39,8 +41,14 @@ def run_case(
     out_dir: Path,
     *,
     progress: bool = True,
+    checkpoint_every: int = 0,
+    resume: Path | None = None,
 ) -> dict[str, Any]:
-    """Run one case to its end time, writing every output. Returns the summary."""
+    """Run one case to its end time, writing every output. Returns the summary.
+
+    ``checkpoint_every`` > 0 writes ``checkpoint.npz`` every that many frames; ``resume``
+    continues from such a checkpoint into the same output folder (bitwise the same result as an
+    uninterrupted run on the CPU)."""
     from .output import OutputWriter
     from .simulation import Simulation, SimulationError
 
@@ -92,14 +100,26 @@ def run_case(
         writer.frame(index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"])
         return mon
 
-    first = frame(0)
+    k0 = 0
+    if resume is not None:
+        extra = sim.load_checkpoint(resume)
+        k0 = int(extra["frame"])
+        writer.resume()
+        prev = out_dir / "summary.json"
+        first = json.loads(prev.read_text())["initial"] if prev.is_file() else sim.monitors()
+        print(f"resumed from {resume} at frame {k0}, t = {sim.t:.6g} s", file=sys.stderr)
+    else:
+        first = frame(0)
     summary["initial"] = first
     last = first
     bar = _progress(total, sim.dt) if progress else None
+    if bar is not None:
+        bar.update(sim.steps)
     step_wall = 0.0
+    steps0 = sim.steps
     chunk = max(1, min(steps_per_frame, 2000))
     try:
-        for k in range(1, n_frames + 1):
+        for k in range(k0 + 1, n_frames + 1):
             done = 0
             while done < steps_per_frame:
                 n = min(chunk, steps_per_frame - done)
@@ -109,9 +129,11 @@ def run_case(
                 done += n
                 if bar is not None:
                     bar.update(n)
-                    sps = sim.steps / step_wall if step_wall > 0 else 0.0
+                    sps = (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0
                     bar.set_description(f"t = {sim.t * 1e6:.1f} us, {sps:,.0f} steps/s")
             last = frame(k)
+            if checkpoint_every and k % checkpoint_every == 0:
+                sim.save_checkpoint(out_dir / "checkpoint.npz", {"frame": k})
         summary["status"] = "complete"
     except SimulationError as e:
         summary["status"] = "failed"
@@ -126,13 +148,17 @@ def run_case(
             simulated_s=sim.t,
             wall_s=time.perf_counter() - wall0,
             step_wall_s=step_wall,
-            steps_per_s=sim.steps / step_wall if step_wall > 0 else math.nan,
+            steps_per_s=(sim.steps - steps0) / step_wall if step_wall > 0 else math.nan,
             final=last,
             T_peak_C=last.get("T_peak_C"),
         )
         writer.summary(summary)
         writer.finish()
     return summary
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -149,6 +175,14 @@ def main(argv: list[str] | None = None) -> int:
         help="override a case key, e.g. --set lasers.0.power_W=15 --set time.end_s=1e-4",
     )
     ap.add_argument("--no-progress", action="store_true", help="no progress bar")
+    ap.add_argument(
+        "--checkpoint-every",
+        type=int,
+        default=0,
+        metavar="FRAMES",
+        help="write OUT/checkpoint.npz (the full state) every FRAMES output frames",
+    )
+    ap.add_argument("--resume", metavar="CHECKPOINT", help="continue a run from its checkpoint.npz")
     args = ap.parse_args(argv)
     try:
         case = load_case(args.case, args.set)
@@ -159,7 +193,19 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     out = Path(args.out) if args.out else Path("out") / case.case.name
-    summary = run_case(case, out, progress=not args.no_progress)
+    # a killed run (SIGTERM) ends like Ctrl-C: outputs closed, summary marked interrupted
+    signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        summary = run_case(
+            case,
+            out,
+            progress=not args.no_progress,
+            checkpoint_every=args.checkpoint_every,
+            resume=Path(args.resume) if args.resume else None,
+        )
+    except CaseError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     fin = summary["final"]
     print(
         f"{summary['status']}: {summary['steps']} steps, {summary['simulated_s'] * 1e3:.3g} ms "

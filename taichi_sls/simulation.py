@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
 import time
+from pathlib import Path
 
 import numpy as np
 import taichi as ti
@@ -140,6 +142,47 @@ class Simulation:
                 f"Jacobian J = {mon['J_min']:.3g} <= 0 (inverted point) {where}; likely cause: "
                 f"{hint}"
             )
+
+    # ------------------------------------------------------------------ checkpoints
+    _POINT_FIELDS = ("x", "x0", "v", "C", "F", "eps", "eps_pl", "alpha", "e_iso", "sigma", "J")
+    _POINT_FIELDS += ("H", "T", "xi")
+    _SCALARS = ("t", "dt", "laser_energy", "heat_out", "T_peak")
+
+    def save_checkpoint(self, path: Path, extra: dict | None = None) -> None:
+        """The full state (points and scalars; the grid is rebuilt every step), written
+        atomically. ``extra`` (numbers) is stored alongside, e.g. the frame index."""
+        st = self.state
+        data = {f"p_{k}": getattr(st, k).to_numpy() for k in self._POINT_FIELDS}
+        data.update({f"s_{k}": np.array(getattr(st, k)[None]) for k in self._SCALARS})
+        data["steps"] = np.array(self.steps)
+        data["case_name"] = np.array(self.case.case.name)
+        for k, v in (extra or {}).items():
+            data[f"x_{k}"] = np.array(v)
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp.npz")
+        np.savez(tmp, **data)
+        os.replace(tmp, path)
+
+    def load_checkpoint(self, path: Path) -> dict:
+        """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``."""
+        try:
+            z = np.load(path)
+        except (OSError, ValueError) as e:
+            raise CaseError(f"--resume {path}: not a readable checkpoint ({e})") from None
+        st = self.state
+        n = z["p_x"].shape[0]
+        if n != st.n_points or str(z["case_name"]) != self.case.case.name:
+            raise CaseError(
+                f"--resume {path}: checkpoint of case {str(z['case_name'])!r} with {n} points "
+                f"does not match case {self.case.case.name!r} with {st.n_points} points"
+            )
+        for k in self._POINT_FIELDS:
+            getattr(st, k).from_numpy(z[f"p_{k}"])
+        for k in self._SCALARS:
+            getattr(st, k)[None] = float(z[f"s_{k}"])
+        self.dt = float(z["s_dt"])
+        self.steps = int(z["steps"])
+        return {k[2:]: z[k].item() for k in z.files if k.startswith("x_")}
 
     def snapshot(self) -> dict[str, np.ndarray]:
         st = self.state
