@@ -5,7 +5,8 @@ mass centroids of bodies 0 and 1, take every vertical node column and measure th
 {y : phi(x, y) < 0} along it (phi linear between nodes); the contact line is the smallest such
 length -- the narrowest vertical section of material between the two bodies. It follows the neck
 when the pair slides, counts only material (a hole in the neck shortens it) and drops to zero when
-the neck tears.
+the neck tears. ``neck_span_um`` reports, for the same column, the outer extent from the lowest to
+the highest material (holes included): the silhouette's neck.
 """
 
 import numpy as np
@@ -70,14 +71,39 @@ def column_material_length(phi_col: np.ndarray, h: float) -> float:
     return total
 
 
-def contact_line(phi: np.ndarray, h: float, off: int, x_left: float, x_right: float) -> float:
-    """Narrowest material section (m) over node columns strictly between x_left and x_right."""
-    best = np.inf
+def column_span(phi_col: np.ndarray, h: float) -> float:
+    """Distance from the lowest to the highest crossing of a piecewise-linear phi (holes
+    included)."""
+    neg = np.nonzero(phi_col < 0)[0]
+    if len(neg) == 0:
+        return 0.0
+    lo, hi = neg[0], neg[-1]
+    y0 = lo * h
+    if lo > 0:
+        a, b = phi_col[lo - 1], phi_col[lo]
+        y0 -= h * b / (b - a)
+    y1 = hi * h
+    if hi < len(phi_col) - 1:
+        a, b = phi_col[hi], phi_col[hi + 1]
+        y1 += h * a / (a - b)
+    return float(y1 - y0)
+
+
+def contact_line(
+    phi: np.ndarray, h: float, off: int, x_left: float, x_right: float, span: bool = False
+) -> float:
+    """Narrowest material section (m) over node columns strictly between x_left and x_right.
+    With ``span``: the outer extent (holes included) of that same narrowest column."""
+    best, best_i = np.inf, -1
     for i in range(phi.shape[0]):
         x = (i - off) * h
         if x_left < x < x_right:
-            best = min(best, column_material_length(phi[i], h))
-    return float(best) if np.isfinite(best) else float("nan")
+            v = column_material_length(phi[i], h)
+            if v < best:
+                best, best_i = v, i
+    if best_i < 0:
+        return float("nan")
+    return column_span(phi[best_i], h) if span else float(best)
 
 
 def body_centroids_x(x: np.ndarray, body: np.ndarray, mass: np.ndarray) -> list[float]:

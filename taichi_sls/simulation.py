@@ -103,13 +103,16 @@ class Simulation:
             level_set_only(self.state)
         return self.state.phi.to_numpy()
 
-    def contact_line_m(self) -> float:
+    def contact_line_m(self) -> tuple[float, float]:
+        """(contact line, neck span) in metres; see :mod:`taichi_sls.monitor`."""
         if not self._centroid_pair:
-            return float("nan")
+            return float("nan"), float("nan")
         x = self.state.x.to_numpy()
         cx = body_centroids_x(x, self.scene.body, self._x_mass)
         lo, hi = sorted(cx[:2])
-        return contact_line(self.phi(), self.state.h, self.state.off, lo, hi)
+        phi = self.phi()
+        h, off = self.state.h, self.state.off
+        return contact_line(phi, h, off, lo, hi), contact_line(phi, h, off, lo, hi, span=True)
 
     def monitors(self) -> dict[str, float]:
         st = self.state
@@ -120,7 +123,9 @@ class Simulation:
         out["T_peak_C"] = float(st.T_peak[None] - KELVIN)
         out["laser_energy_J_per_m"] = float(st.laser_energy[None])
         out["heat_out_J_per_m"] = float(st.heat_out[None])
-        out["contact_line_um"] = self.contact_line_m() * 1e6
+        cl, span = self.contact_line_m()
+        out["contact_line_um"] = cl * 1e6
+        out["neck_span_um"] = span * 1e6
         self._guard(out, bad)
         return out
 
@@ -129,9 +134,7 @@ class Simulation:
         hint = f"time step {self.dt:.3g} s against the limits " + ", ".join(
             f"{k} {v:.3g} s" for k, v in self.dt_limits.items()
         )
-        if bad == 1.0 or not all(
-            math.isfinite(v) for k, v in mon.items() if k != "contact_line_um"
-        ):
+        if bad == 1.0 or not all(math.isfinite(v) for k, v in mon.items() if not k.endswith("_um")):
             raise SimulationError(
                 f"NaN or infinity in the point state {where}; likely cause: {hint}"
             )

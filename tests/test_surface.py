@@ -160,21 +160,34 @@ def test_contact_line_on_constructed_shapes():
     inside = ((X < 15) | (X > 25)) & (np.abs(Y - 20) < 10)
     neck = (np.abs(X - 20) <= 5) & (np.abs(Y - 20) < 3)
     phi = np.where(inside | neck, -1.0, 1.0)
-    # a sharp 0/1 phi makes crossings fall half way between nodes: the neck spans y in 17..23
-    assert contact_line(phi, h, off, 5.0, 35.0) == pytest.approx(6.0)
+    # a sharp +-1 phi puts crossings half way between nodes: the neck spans y in 17.5..22.5
+    assert contact_line(phi, h, off, 5.0, 35.0) == pytest.approx(5.0)
     # a hole in the neck counts as missing material
     holed = phi.copy()
     holed[20, 20] = 1.0
-    assert contact_line(holed, h, off, 5.0, 35.0) == pytest.approx(5.0)
+    assert contact_line(holed, h, off, 5.0, 35.0) == pytest.approx(4.0)
     # a torn neck reads zero
     torn = phi.copy()
     torn[19:22, :] = 1.0
     assert contact_line(torn, h, off, 5.0, 35.0) == 0.0
     # linear phi: exact crossing
-    assert column_material_length(np.array([1.0, -1.0, -1.0, 3.0]), 2.0) == pytest.approx(3.0)
+    # negative over 1 + 2 + 0.5 (crossings at 1/2 and 1/4 of their 2-wide intervals)
+    assert column_material_length(np.array([1.0, -1.0, -1.0, 3.0]), 2.0) == pytest.approx(3.5)
 
 
 def test_paper_scene_starts_near_8um():
     sim = Simulation(make_case(deep_update(PAPER_SCENE, {"physics": {"thermal": False}})))
     cl = sim.monitors()["contact_line_um"]
     assert 7.5 < cl < 9.0  # the paper's Fig. 4a: 8 um
+
+
+def test_neck_span_counts_holes():
+    h, off = 1.0, 0
+    xs = np.arange(41) * h
+    X, Y = np.meshgrid(xs, xs, indexing="ij")
+    inside = ((X < 15) | (X > 25)) & (np.abs(Y - 20) < 10)
+    neck = (np.abs(X - 20) <= 5) & (np.abs(Y - 20) < 3)
+    phi = np.where(inside | neck, -1.0, 1.0)
+    phi[20, 20] = 1.0  # a hole: the material length drops, the span does not
+    assert contact_line(phi, h, off, 5.0, 35.0) == pytest.approx(4.0)
+    assert contact_line(phi, h, off, 5.0, 35.0, span=True) == pytest.approx(5.0)
