@@ -159,6 +159,12 @@ class Solver:
         choices=("apic", "flip", "pic_flip"),
         doc="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + (1-flip_ratio)*PIC",
     )
+    update: str = _opt(
+        "musl",
+        choices=("musl", "usl"),
+        doc="usl: eqs. 14-17 as printed; musl: move points with the remapped grid velocity "
+        "(bounded on nearly empty nodes)",
+    )
     flip_ratio: float = _opt(0.95, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
     arch: str = _opt("cpu", choices=("cpu", "gpu"), doc="Taichi backend")
     precision: str = _opt("f64", choices=("f64", "f32"), doc="floating point precision")

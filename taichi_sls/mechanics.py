@@ -6,6 +6,13 @@ Transfers (case option ``solver.transfer``):
 - ``apic``: affine PIC (Jiang et al. 2015) with the uGIMP inertia D_p = sum N_ip (x_i - x_p)^2,
   which is diagonal and position dependent for GIMP (between h^2/8 and h^2/4).
 Positions follow eq. 15 (the PIC grid velocity) in every variant.
+
+Update (``solver.update``): ``usl`` moves the points with the grid velocity v^{n+1} = v^n + dt f/m
+as eqs. 14-17 print it; ``musl`` (modified USL, Sulsky et al. 1995; Bardenhagen 2002) first updates
+the point velocities, maps their momenta back to the grid, and moves the points and computes L with
+that remapped velocity. On a node that a point barely touches, f/m is the stress term divided by a
+tiny mass and USL's velocity there is unbounded (a point that strays from the body is flung away);
+the remapped velocity is a weighted mean of point velocities and stays bounded.
 """
 
 import taichi as ti
@@ -78,22 +85,17 @@ def grid_velocity(st: ti.template(), I, dt):
 
 
 @ti.func
-def g2p_mechanics(st: ti.template(), p, base, w, dw, dt):
-    """Velocity (transfer variant), position (eq. 15), velocity gradient, F (eq. 17), J (eq. 18).
-
-    Returns the velocity gradient L for the constitutive update.
-    """
+def g2p_velocity(st: ti.template(), p, base, w, dw):
+    """The point velocity from the grid (transfer variant; eq. 14 for FLIP)."""
     xp = st.x[p]
     v_pic = ti.Vector.zero(float, st.dim)
     dv = ti.Vector.zero(float, st.dim)
-    L = ti.Matrix.zero(float, st.dim, st.dim)
     B = ti.Matrix.zero(float, st.dim, st.dim)
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         I = base + o
         vi = st.gv[I]
         v_pic += N * vi
-        L += vi.outer_product(gN)
         if ti.static(st.transfer == 2):
             B += N * vi.outer_product(node_x(st, I) - xp)
         else:
@@ -114,8 +116,46 @@ def g2p_mechanics(st: ti.template(), p, base, w, dw, dt):
             for c in ti.static(range(st.dim)):
                 B[c, d] /= Dd
         st.C[p] = B
-    st.x[p] = xp + dt * v_pic
+
+
+@ti.func
+def g2p_kinematics(st: ti.template(), p, base, w, dw, dt):
+    """Position (eq. 15), velocity gradient, F (eq. 17) and J (eq. 18) from the grid velocity.
+
+    Returns the velocity gradient L for the constitutive update.
+    """
+    v_grid = ti.Vector.zero(float, st.dim)
+    L = ti.Matrix.zero(float, st.dim, st.dim)
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        vi = st.gv[base + o]
+        v_grid += N * vi
+        L += vi.outer_product(gN)
+    st.x[p] += dt * v_grid
     F = (ti.Matrix.identity(float, st.dim) + dt * L) @ st.F[p]
     st.F[p] = F
     st.J[p] = F.determinant()
     return L
+
+
+@ti.func
+def p2g_momentum(st: ti.template(), p, base, w, dw):
+    """MUSL: the updated point momenta back to the grid (affine part included for APIC)."""
+    xp = st.x[p]
+    mp = st.mass[p]
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        mv = st.v[p]
+        if ti.static(st.transfer == 2):
+            mv += st.C[p] @ (node_x(st, I) - xp)
+        st.gmv[I] += N * mp * mv
+
+
+@ti.func
+def grid_remap_velocity(st: ti.template(), I):
+    """MUSL: the grid velocity from the remapped momenta, walls applied; empty nodes rest."""
+    v = ti.Vector.zero(float, st.dim)
+    if st.gm[I] > st.mass_cut:
+        v = apply_walls(st, I, st.gmv[I] / st.gm[I])
+    st.gv[I] = v

@@ -48,6 +48,7 @@ class State:
         self.n_lasers = len(case.lasers)
         self.laser = self.thermal and any(las.power_W > 0 for las in case.lasers)
         self.transfer = TRANSFERS[case.solver.transfer]
+        self.musl = case.solver.update == "musl"
         self.flip_ratio = case.solver.flip_ratio
         b = case.boundary
         self.wall_mech = tuple(WALL_MECH[w.mechanical] for w in (b.left, b.right, b.bottom, b.top))

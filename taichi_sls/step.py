@@ -18,7 +18,14 @@ import taichi as ti
 
 from .constitutive import embed3, perzyna_update
 from .materials import P, lerp_phase
-from .mechanics import g2p_mechanics, grid_velocity, p2g_mechanics
+from .mechanics import (
+    g2p_kinematics,
+    g2p_velocity,
+    grid_remap_velocity,
+    grid_velocity,
+    p2g_mechanics,
+    p2g_momentum,
+)
 from .shape import stencil
 from .state import State
 from .surface import level_set, scatter_level_set, surface_forces
@@ -87,39 +94,61 @@ def grid_update(st: ti.template(), dt):
 
 
 @ti.func
+def constitutive(st: ti.template(), p, L, dt):
+    """Strain increment (eqs. 16-17, 34) and the Perzyna update (eqs. 38-45)."""
+    eps = st.eps[p] + 0.5 * (L + L.transpose()) * dt
+    st.eps[p] = eps
+    sig, epl, a = perzyna_update(
+        st.matp,
+        st.mat[p],
+        embed3(eps),
+        st.eps_pl[p],
+        st.alpha[p],
+        st.e_iso[p],
+        st.xi[p],
+        st.T[p],
+        dt,
+        st.plastic,
+        st.paper_stress,
+    )
+    st.sigma[p] = sig
+    st.eps_pl[p] = epl
+    st.alpha[p] = a
+
+
+@ti.func
+def g2p_point(st: ti.template(), p, base, w, dw, dt, kinematics: ti.template()):
+    """Heat, thermal strains and velocity of point p; with ``kinematics`` (USL) also its motion
+    and stress."""
+    if ti.static(st.thermal):
+        dT, dxi = g2p_heat(st, p, base, w, dw)
+        if ti.static(st.th_strain and st.mech):
+            # eqs. 36-37: alpha at the step's mean solid fraction
+            m = st.mat[p]
+            alpha = lerp_phase(st.matp, m, st.xi[p] - 0.5 * dxi, "alpha_c", "alpha_m")
+            st.e_iso[p] += alpha * dT + st.matp[m, P["beta"]] * dxi
+    if ti.static(st.mech):
+        g2p_velocity(st, p, base, w, dw)
+        if ti.static(kinematics):
+            constitutive(st, p, g2p_kinematics(st, p, base, w, dw, dt), dt)
+
+
+@ti.func
 def g2p(st: ti.template(), dt):
     for p in range(st.n_points):
         base, w, dw = _stencil(st, p)
-        dT = 0.0
-        dxi = 0.0
-        if ti.static(st.thermal):
-            dT, dxi = g2p_heat(st, p, base, w, dw)
-        if ti.static(st.mech):
-            L = g2p_mechanics(st, p, base, w, dw, dt)
-            eps = st.eps[p] + 0.5 * (L + L.transpose()) * dt  # eqs. 16-17, 34
-            st.eps[p] = eps
-            m = st.mat[p]
-            xi = st.xi[p]
-            if ti.static(st.th_strain):
-                # eqs. 36-37: alpha at the step's mean solid fraction
-                alpha = lerp_phase(st.matp, m, xi - 0.5 * dxi, "alpha_c", "alpha_m")
-                st.e_iso[p] += alpha * dT + st.matp[m, P["beta"]] * dxi
-            sig, epl, a = perzyna_update(
-                st.matp,
-                m,
-                embed3(eps),
-                st.eps_pl[p],
-                st.alpha[p],
-                st.e_iso[p],
-                xi,
-                st.T[p],
-                dt,
-                st.plastic,
-                st.paper_stress,
-            )
-            st.sigma[p] = sig
-            st.eps_pl[p] = epl
-            st.alpha[p] = a
+        g2p_point(st, p, base, w, dw, dt, not st.musl)
+    if ti.static(st.musl and st.mech):
+        for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+            st.gmv[I] = ti.Vector.zero(float, st.dim)
+        for p in range(st.n_points):
+            base, w, dw = _stencil(st, p)
+            p2g_momentum(st, p, base, w, dw)
+        for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+            grid_remap_velocity(st, I)
+        for p in range(st.n_points):
+            base, w, dw = _stencil(st, p)
+            constitutive(st, p, g2p_kinematics(st, p, base, w, dw, dt), dt)
 
 
 @ti.func
