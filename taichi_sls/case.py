@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
+
 
 class CaseError(ValueError):
     """A case file (or an override) is invalid. The message names key, value and what is allowed."""
@@ -31,8 +33,9 @@ def _opt(
     nonneg: bool = False,
     doc: str = "",
     factory: Any = None,
+    maximum: float | None = None,
 ) -> Any:
-    meta = {"choices": choices, "positive": positive, "nonneg": nonneg, "doc": doc}
+    meta = {"choices": choices, "positive": positive, "nonneg": nonneg, "doc": doc, "max": maximum}
     if factory is not None:
         return field(default_factory=factory, metadata=meta)
     return field(default=default, metadata=meta)
@@ -48,10 +51,16 @@ class CaseInfo:
 class Grid:
     spacing_um: float = _opt(2.0, positive=True, doc="grid spacing h (um)")
     points_per_cell: int = _opt(
-        2, positive=True, doc="material points per cell along each axis (2 -> 2x2 quarter points)"
+        2,
+        positive=True,
+        maximum=8,
+        doc="material points per cell along each axis (2 -> 2x2 quarter points)",
     )
     ghost_cells: int = _opt(
-        1, nonneg=True, doc="extra cells beyond left/right/bottom walls (surface tension stencil)"
+        1,
+        nonneg=True,
+        maximum=8,
+        doc="extra cells beyond left/right/bottom walls (surface tension stencil)",
     )
 
 
@@ -224,17 +233,19 @@ class SurfaceTension:
     point_radius_over_h: float = _opt(
         0.375, positive=True, doc="r_p / h in eq. 21; > sqrt(2)/4 so interior nodes read inside"
     )
-    band_cells: int = _opt(3, positive=True, doc="half-width of the level-set band (cells)")
+    band_cells: int = _opt(
+        3, positive=True, maximum=8, doc="half-width of the level-set band (cells)"
+    )
     level_set: str = _opt(
         "redistanced",
         choices=("redistanced", "raw"),
         doc="redistanced: signed distance to the eq. 21 zero contour; raw: eq. 21 as printed",
     )
     level_set_smoothing_passes: int = _opt(
-        8, nonneg=True, doc="binomial smoothing passes over phi before the curvature fit"
+        8, nonneg=True, maximum=64, doc="binomial smoothing passes over phi before the fit"
     )
     smoothing_passes: int = _opt(
-        16, nonneg=True, doc="mass-weighted curvature smoothing passes over interface nodes"
+        16, nonneg=True, maximum=64, doc="mass-weighted curvature smoothing passes"
     )
     zero_net_force: bool = _opt(
         True, doc="remove the CSF resultant left by curvature noise (mass-weighted)"
@@ -246,11 +257,13 @@ class SurfaceTension:
 
 @dataclass
 class Output:
-    frames: int = _opt(20, positive=True, doc="number of output frames over the run")
+    frames: int = _opt(
+        20, positive=True, maximum=100000, doc="number of output frames over the run"
+    )
     png: bool = _opt(True, doc="write frames/*.png")
     gif: bool = _opt(True, doc="write animation.gif from the frames")
     vtu: bool = _opt(False, doc="write ParaView point data (points_*.vtu + points.pvd)")
-    dpi: int = _opt(80, positive=True, doc="resolution of the frames")
+    dpi: int = _opt(80, positive=True, maximum=600, doc="resolution of the frames")
     deformation: str = _opt(
         "displacement",
         choices=("displacement", "plastic_strain"),
@@ -350,6 +363,8 @@ def _build(cls: type, data: dict, prefix: str) -> Any:
             raise CaseError(f"{key} = {v!r}: must be > 0")
         if meta.get("nonneg") and isinstance(v, (int, float)) and not v >= 0:
             raise CaseError(f"{key} = {v!r}: must be >= 0")
+        if meta.get("max") is not None and isinstance(v, (int, float)) and v > meta["max"]:
+            raise CaseError(f"{key} = {v!r}: must be at most {meta['max']}")
         kwargs[name] = v
     return cls(**kwargs)
 
@@ -425,6 +440,12 @@ def validate(case: Case) -> None:
     h = case.grid.spacing_um
     if h > min(W, Hh) / 2:
         raise CaseError(f"grid.spacing_um = {h}: must be at most half the smaller domain side")
+    cells = (W / h) * (Hh / h)
+    if cells > MAX_CELLS:
+        raise CaseError(
+            f"grid.spacing_um = {h}: {cells:.3g} cells in a {W} x {Hh} um domain; at most "
+            f"{MAX_CELLS:.0e} are allowed (memory)"
+        )
     if not case.bodies:
         raise CaseError("bodies: at least one [[bodies]] table is required")
     for name, m in case.materials.items():

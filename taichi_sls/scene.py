@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .case import Case
+from .case import Case, CaseError
 
 PAD = 2  # cells of array margin beyond the ghost layer
 
@@ -66,6 +66,12 @@ def build_scene(case: Case) -> Scene:
         sel = _inside(b, PX, PY) & ~taken
         taken |= sel
         k = int(sel.sum())
+        if k == 0:
+            raise CaseError(
+                f"bodies[{bi}]: holds no material point at grid.spacing_um = {h_um} "
+                f"({case.grid.points_per_cell}x{case.grid.points_per_cell} per cell); make it "
+                "larger or the grid finer"
+            )
         xs.append(np.stack([PX[sel], PY[sel]], axis=1))
         bodies.append(np.full(k, bi, dtype=np.int32))
         mats.append(np.full(k, names.index(b.material), dtype=np.int32))
