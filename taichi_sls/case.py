@@ -247,6 +247,12 @@ class SurfaceTension:
     smoothing_passes: int = _opt(
         16, nonneg=True, maximum=64, doc="mass-weighted curvature smoothing passes"
     )
+    colour_threshold: float = _opt(
+        0.0,
+        nonneg=True,
+        maximum=0.9,
+        doc="CSF acts on nodes above this fraction of a full cell's mass (0: eq. 19 as printed)",
+    )
     zero_net_force: bool = _opt(
         True, doc="remove the CSF resultant left by curvature noise (mass-weighted)"
     )

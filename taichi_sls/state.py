@@ -63,6 +63,7 @@ class State:
         self.smooth_passes = st.smoothing_passes
         self.blur_passes = st.level_set_smoothing_passes
         self.zero_net_force = st.zero_net_force
+        self.csf_c0 = st.colour_threshold
         self.kappa_cap = st.curvature_cap_h / scene.h if st.curvature_cap_h > 0 else 0.0
         self.phi_cap = (st.band_cells + 1) * scene.h
 

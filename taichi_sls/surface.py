@@ -265,12 +265,20 @@ def csf_force(st: ti.template()):
     Surface tension on a closed surface has no resultant, but the discrete CSF force keeps a
     small one from the curvature's noise (0.3 % of |f| on a disc of points, enough to set it
     drifting). With ``zero_net_force`` the resultant is removed in proportion to node mass."""
-    coef = 2.0 * st.gamma / (st.rho_ref * st.rho_ref * st.cell_volume)
+    # f_i = V_c gamma kappa grad(c) w(c), c = m_i / (rho V_c): eq. 19 is w = 2c. With a colour
+    # threshold c0 > 0, w = 2 max(c - c0, 0) / (1 - c0)^2 keeps the force across an interface
+    # (the integral of w dc over [0, 1] is 1) but gives none to nodes that only a few stray
+    # points touch: the CSF acceleration does not fall with node mass, and a lone point in a
+    # concave pocket was flung out of the box.
+    c0 = ti.static(st.csf_c0)
+    full = st.rho_ref * st.cell_volume
+    coef = st.gamma / (st.rho_ref * (1.0 - c0) * (1.0 - c0))
     if ti.static(st.zero_net_force):
         st.red_f[None] = ti.Vector.zero(float, 3)
     for i, j in ti.ndrange(st.nx, st.ny):
         if st.kvalid[i, j] & 2:
-            f = coef * st.kappa[i, j] * st.gm[i, j] * st.gradm[i, j]
+            wc = 2.0 * ti.max(st.gm[i, j] / full - c0, 0.0)
+            f = coef * st.kappa[i, j] * wc * st.gradm[i, j]
             st.gf[i, j] += f
             if ti.static(st.zero_net_force):
                 st.red_f[None] += ti.Vector([f[0], f[1], st.gm[i, j]])
