@@ -169,10 +169,10 @@ class Solver:
         doc="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + (1-flip_ratio)*PIC",
     )
     update: str = _opt(
-        "musl",
-        choices=("musl", "usl"),
+        "usl",
+        choices=("usl", "musl"),
         doc="usl: eqs. 14-17 as printed; musl: move points with the remapped grid velocity "
-        "(bounded on nearly empty nodes)",
+        "(bounded on nearly empty nodes, but slows capillary flow)",
     )
     flip_ratio: float = _opt(0.95, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
     arch: str = _opt("cpu", choices=("cpu", "gpu"), doc="Taichi backend")
