@@ -91,23 +91,7 @@ def material_row(m: Material, T_ref_C: float) -> "np.ndarray":
     return np.array([vals[n] for n in P_NAMES], dtype=np.float64)
 
 
-# ----------------------------------------------------------------- host-side twins (for tests)
-
-
-def enthalpy_np(m: Material, T_C: np.ndarray, T_ref_C: float = 0.0) -> np.ndarray:
-    """H(T) of the module docstring, numpy, temperatures in C."""
-    r = material_row(m, T_ref_C)
-    T = np.asarray(T_C, dtype=float) + KELVIN
-    T_c, T_m, c_c, c_m = r[P["T_c"]], r[P["T_m"]], r[P["c_c"]], r[P["c_m"]]
-    s = np.clip(T - T_c, 0.0, T_m - T_c)
-    dT = T_m - T_c
-    H = c_c * (np.minimum(T, T_c) - r[P["T_ref"]])
-    H = H + c_c * s + (c_m - c_c) * s * s / (2 * dT) + r[P["l_s"]] * s / dT
-    return H + c_m * np.maximum(T - T_m, 0.0)
-
-
-def youngs_np(m: Material, xi_s: float) -> float:
-    return xi_s * m.youngs_solid_Pa + (1 - xi_s) * m.youngs_liquid_Pa
+# ----------------------------------------------------------------------------- host side
 
 
 def p_wave_modulus(E: float, nu: float) -> float:
