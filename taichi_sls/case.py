@@ -187,8 +187,9 @@ class Solver:
         "p = lambda tr(eps) as printed",
     )
     optimize: bool = _opt(
-        True,
-        doc="full compiler optimisation (false: ~10x faster compile, ~1.6x slower steps)",
+        False,
+        doc="Taichi's advanced optimisation: ~1.5x faster steps after a ~100 s one-off compile "
+        "(cached on disk); false compiles in ~5-10 s",
     )
     strain: str = _opt(
         "small",

@@ -73,7 +73,8 @@ def run_case(
     )
     writer.write_case(to_toml(case_to_dict(case)))
     n_frames = o.frames
-    steps_per_frame = max(1, int(round(case.time.end_s / n_frames / sim.dt)))
+    # whole steps per frame, rounded up so that the run reaches end_s
+    steps_per_frame = max(1, math.ceil(case.time.end_s / n_frames / sim.dt - 1e-9))
     total = steps_per_frame * n_frames
     print(
         f"{case.case.name}: {sc.n_points} points, {sc.table1_nodes} nodes "

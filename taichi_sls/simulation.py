@@ -22,10 +22,11 @@ class SimulationError(RuntimeError):
     """The guard tripped: the state is no longer physical. The message says what and where."""
 
 
-def init_taichi(arch: str = "cpu", precision: str = "f64", optimize: bool = True) -> None:
+def init_taichi(arch: str = "cpu", precision: str = "f64", optimize: bool = False) -> None:
     """(Re)initialise Taichi. Re-initialising frees every field, so one Simulation is live at a
     time. ``optimize=False`` skips Taichi's advanced IR optimisation: the fused step compiles in
-    about 5 s instead of 45 s and runs about 1.6x slower (measured on the paper's fine case)."""
+    5-10 s instead of about 100 s and runs about 1.5x slower (914 against ~650 steps/s on the
+    paper's fine case, 2-core CPU)."""
     ti.init(
         arch=ti.cpu if arch == "cpu" else ti.gpu,
         default_fp=ti.f64 if precision == "f64" else ti.f32,
