@@ -17,9 +17,13 @@ from .state import State
 
 @ti.kernel
 def reduce_points(st: ti.template()):
-    """red = [T_max, sum m T, sum m, sum m (1 - xi), sum m H, kinetic energy, J_min, bad]."""
+    """red = [T_max, sum m T, sum m, sum m (1 - xi), sum m H, kinetic energy, J_min, bad,
+    T_min, J_max, |v|_max]."""
     st.red[0] = -1e30
     st.red[6] = 1e30
+    st.red[8] = 1e30
+    st.red[9] = -1e30
+    st.red[10] = 0.0
     for k in ti.static(range(1, 6)):
         st.red[k] = 0.0
     st.red[7] = 0.0
@@ -38,6 +42,9 @@ def reduce_points(st: ti.template()):
         st.red[4] += m * st.H[p]
         st.red[5] += 0.5 * m * st.v[p].norm_sqr()
         ti.atomic_min(st.red[6], st.J[p])
+        ti.atomic_min(st.red[8], st.T[p])
+        ti.atomic_max(st.red[9], st.J[p])
+        ti.atomic_max(st.red[10], st.v[p].norm())
         x = st.x[p]
         bad = 0.0
         if not (x[0] == x[0] and x[1] == x[1] and st.T[p] == st.T[p] and st.J[p] == st.J[p]):
@@ -58,6 +65,9 @@ def point_monitors(st: State) -> dict[str, float]:
         "kinetic_energy_J_per_m": float(r[5]),
         "J_min": float(r[6]),
         "_bad": float(r[7]),
+        "_T_min": float(r[8]),
+        "_J_max": float(r[9]),
+        "_v_max": float(r[10]),
     }
 
 

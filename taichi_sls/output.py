@@ -297,6 +297,11 @@ class OutputWriter:
             w.writerow(cells + [""] * (n - len(cells)))
         atomic_write_text(self.out_dir / "timeseries.csv", buf.getvalue())
 
+    @property
+    def next_index(self) -> int:
+        """The frame index after the last one written (or found when resuming)."""
+        return max(self._png_paths, default=self.frames_written - 1) + 1
+
     def resume(self) -> None:
         """Continue an existing output folder: keep its time series rows and frames."""
         path = self.out_dir / "timeseries.csv"

@@ -139,6 +139,13 @@ def run_case(
     except SimulationError as e:
         summary["status"] = "failed"
         summary["error"] = str(e)
+        # the offending state beside the last good frame: full state and one more image
+        sim.save_checkpoint(out_dir / "failed_state.npz", {"frame": n_frames})
+        snap = sim.snapshot()
+        deform = snap["displacement_um" if o.deformation == "displacement" else "plastic_strain"]
+        writer.frame(
+            writer.next_index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"]
+        )
     except KeyboardInterrupt:
         summary["status"] = "interrupted"
     finally:

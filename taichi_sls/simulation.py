@@ -85,6 +85,10 @@ class Simulation:
         advance(self.state, 0, self.gpu)  # compiles the step kernel
         self.compile_s = time.perf_counter() - t0
         self._x_mass = self.state.mass.to_numpy()
+        # conduction obeys a maximum principle: no point may cool below the coldest start or wall
+        walls = [w.temperature_C for w in vars(case.boundary).values() if w.thermal == "fixed"]
+        coldest = min([float(self.scene.T0_C.min()), *walls])
+        self._T_floor = coldest + KELVIN if case.physics.thermal else -math.inf
         self._centroid_pair = len(case.bodies) >= 2
 
     @property
@@ -116,10 +120,11 @@ class Simulation:
         return contact_line(phi, h, off, lo, hi), contact_line(phi, h, off, lo, hi, span=True)
 
     def monitors(self) -> dict[str, float]:
+        """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard."""
         st = self.state
         out = {"t_s": self.t, "step": float(self.steps)}
         pm = point_monitors(st)
-        bad = pm.pop("_bad")
+        internal = {k: pm.pop(k) for k in list(pm) if k.startswith("_")}
         out.update(pm)
         out["T_peak_C"] = float(st.T_peak[None] - KELVIN)
         out["laser_energy_J_per_m"] = float(st.laser_energy[None])
@@ -127,25 +132,94 @@ class Simulation:
         cl, span = self.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6
-        self._guard(out, bad)
+        self._guard(out, internal)
         return out
 
-    def _guard(self, mon: dict[str, float], bad: float) -> None:
-        where = f"at step {self.steps}, t = {self.t:.6g} s"
+    # guard thresholds: a Jacobian beyond this is no longer a small-strain continuum, a point
+    # moving more than this fraction of a cell per step has outrun the grid (the motion limit)
+    J_ABSURD = 20.0
+    MOTION_CELLS = 0.5
+    T_ABSURD_K = 1e4
+
+    def _energy_bound(self) -> float:
+        """Every energy a run can turn into motion: initial kinetic energy, surface energy of the
+        bodies' outlines, potential energy across the domain, laser energy so far (J/m)."""
+        if not hasattr(self, "_e_static"):
+            c = self.case
+            perim = sum(
+                2 * math.pi * b.radius_um
+                if b.shape == "disc"
+                else 2 * (b.max_um[0] - b.min_um[0] + b.max_um[1] - b.min_um[1])
+                for b in c.bodies
+            )
+            gamma = max(m.surface_tension_N_m for m in c.materials.values())
+            g = math.hypot(*c.physics.gravity_m_s2)
+            M = float(self._x_mass.sum())
+            v0 = self.state.v.to_numpy()
+            ke0 = 0.5 * float((self._x_mass * (v0**2).sum(axis=1)).sum())
+            self._e_static = ke0 + gamma * perim * 1e-6 + M * g * self.scene.height
+        return self._e_static + float(self.state.laser_energy[None])
+
+    def _where(self, values: np.ndarray) -> str:
+        """Location of the point where ``values`` is worst (NaN first)."""
+        bad = np.where(np.isfinite(values), values, np.inf)
+        i = int(np.argmax(bad))
+        x = self.state.x.to_numpy()[i] * 1e6
+        return f"point {i} (body {int(self.scene.body[i])}) at x = {x[0]:.2f}, y = {x[1]:.2f} um"
+
+    def _guard(self, mon: dict[str, float], internal: dict[str, float]) -> None:
+        """Stop with one message naming the quantity, step, time, place and likely cause."""
+        st = self.state
+        when = f"at step {self.steps}, t = {self.t:.6g} s"
         hint = f"time step {self.dt:.3g} s against the limits " + ", ".join(
             f"{k} {v:.3g} s" for k, v in self.dt_limits.items()
         )
-        if bad == 1.0 or not all(math.isfinite(v) for k, v in mon.items() if not k.endswith("_um")):
-            raise SimulationError(
-                f"NaN or infinity in the point state {where}; likely cause: {hint}"
+        problem = None
+        finite = all(math.isfinite(v) for k, v in mon.items() if not k.endswith("_um"))
+        if internal["_bad"] == 1.0 or not finite:
+            x = st.x.to_numpy()
+            score = -np.isfinite(x.sum(axis=1) + st.T.to_numpy() + st.J.to_numpy())
+            problem = (f"NaN or infinity in the point state, first at {self._where(score)}", hint)
+        elif internal["_bad"] == 2.0:
+            x = st.x.to_numpy()
+            r = np.abs(x - np.array([self.scene.width, self.scene.height]) / 2).max(axis=1)
+            problem = (f"a point left the grid: {self._where(r)}", hint)
+        elif mon["J_min"] <= 0.0:
+            problem = (
+                f"Jacobian J = {mon['J_min']:.3g} <= 0 (inverted point) at "
+                f"{self._where(-st.J.to_numpy())}",
+                hint,
             )
-        if bad == 2.0:
-            raise SimulationError(f"a point left the grid {where}; likely cause: {hint}")
-        if mon["J_min"] <= 0.0:
-            raise SimulationError(
-                f"Jacobian J = {mon['J_min']:.3g} <= 0 (inverted point) {where}; likely cause: "
-                f"{hint}"
+        elif internal["_J_max"] > self.J_ABSURD:
+            problem = (
+                f"Jacobian J = {internal['_J_max']:.3g} > {self.J_ABSURD} (a point swelled "
+                f"absurdly) at {self._where(st.J.to_numpy())}",
+                hint,
             )
+        elif internal["_v_max"] * self.dt > self.MOTION_CELLS * st.h:
+            problem = (
+                f"a point moves {internal['_v_max'] * self.dt / st.h:.2f} cells per step "
+                f"(|v| = {internal['_v_max']:.3g} m/s) at "
+                f"{self._where(np.linalg.norm(st.v.to_numpy(), axis=1))}",
+                f"the motion limit; {hint}",
+            )
+        elif internal["_T_min"] < self._T_floor - 1.0 or mon["T_max_C"] + KELVIN > self.T_ABSURD_K:
+            T = st.T.to_numpy()
+            worst = np.maximum(self._T_floor - T, T - self.T_ABSURD_K)
+            problem = (
+                f"temperature {T[np.argmax(worst)] - KELVIN:.1f} C outside the physical range "
+                f"[{self._T_floor - KELVIN:.1f} C (coldest start or wall), "
+                f"{self.T_ABSURD_K - KELVIN:.0f} C] at {self._where(worst)}",
+                f"the thermal limit; {hint}",
+            )
+        elif mon["kinetic_energy_J_per_m"] > 10.0 * self._energy_bound():
+            problem = (
+                f"kinetic energy {mon['kinetic_energy_J_per_m']:.3g} J/m exceeds ten times every "
+                f"source of energy ({self._energy_bound():.3g} J/m)",
+                hint,
+            )
+        if problem is not None:
+            raise SimulationError(f"{problem[0]} {when}; likely cause: {problem[1]}")
 
     # ------------------------------------------------------------------ checkpoints
     _POINT_FIELDS = ("x", "x0", "v", "C", "F", "eps", "eps_pl", "alpha", "e_iso", "sigma", "J")

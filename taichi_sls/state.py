@@ -125,7 +125,7 @@ class State:
         self.matp = ti.field(float, (self.nmat, N_PARAMS))
         self.lasp = ti.field(float, (max(self.n_lasers, 1), len(LASER_PARAMS)))
         self.fit = ti.Matrix.field(6, 9, float, ())  # least-squares fit of eq. 23
-        self.red = ti.field(float, 8)  # reductions for monitors
+        self.red = ti.field(float, 12)  # reductions for monitors
         self.red_f = ti.Vector.field(3, float, ())  # CSF resultant and interface mass
         self._vec, self._mat2, self._mat3 = vec, mat2, mat3
         self._fill()
