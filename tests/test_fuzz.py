@@ -91,3 +91,45 @@ def test_any_disc_is_inside_or_refused(cx, cy, r):
     eps = 1e-9 * 80  # validation tolerance
     assert -eps <= cx - r and cx + r <= 80 + eps and -eps <= cy - r and cy + r <= 48 + eps
     assert n > 0
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    power=st.floats(min_value=0.0, max_value=500.0),
+    radius=st.floats(min_value=1.0, max_value=500.0),
+    E=st.floats(min_value=1e2, max_value=1e8),
+    nu=st.floats(min_value=-0.9, max_value=0.49),
+    gamma=st.floats(min_value=0.0, max_value=1.0),
+    dt_factor=st.floats(min_value=0.1, max_value=3.0),
+)
+def test_extreme_cases_run_or_stop_with_our_error(power, radius, E, nu, gamma, dt_factor):
+    """Extreme but valid numbers: the run either advances or stops with the guard's message,
+    never with an exception from inside Taichi or numpy."""
+    from taichi_sls.simulation import Simulation, SimulationError, time_step_limits
+
+    data = deep_update(
+        BASE,
+        {
+            "grid": {"spacing_um": 4.0},
+            "solver": {"optimize": False},
+            "lasers": [{"power_W": power, "spot_radius_um": radius}],
+            "materials": {
+                "PA12": {
+                    "youngs_solid_Pa": E,
+                    "youngs_liquid_Pa": E / 10,
+                    "poisson": nu,
+                    "surface_tension_N_m": gamma,
+                }
+            },
+        },
+    )
+    case = case_from_dict(data)
+    case.time.dt_s = dt_factor * min(time_step_limits(case).values())
+    case.time.allow_unstable_dt = True
+    sim = Simulation(case)
+    try:
+        for _ in range(3):
+            sim.advance(20)
+            sim.monitors()
+    except SimulationError as e:
+        assert "likely cause" in str(e)
