@@ -164,7 +164,7 @@ class Time:
 @dataclass
 class Solver:
     transfer: str = _opt(
-        "apic",
+        "pic_flip",
         choices=("apic", "flip", "pic_flip"),
         doc="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + (1-flip_ratio)*PIC",
     )
@@ -174,7 +174,7 @@ class Solver:
         doc="usl: eqs. 14-17 as printed; musl: move points with the remapped grid velocity "
         "(bounded on nearly empty nodes, but slows capillary flow)",
     )
-    flip_ratio: float = _opt(0.95, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
+    flip_ratio: float = _opt(0.9, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
     arch: str = _opt("cpu", choices=("cpu", "gpu"), doc="Taichi backend")
     precision: str = _opt("f64", choices=("f64", "f32"), doc="floating point precision")
     small_mass: float = _opt(
