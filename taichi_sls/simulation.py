@@ -190,7 +190,7 @@ class Simulation:
         finite = all(math.isfinite(v) for k, v in mon.items() if not k.endswith("_um"))
         if internal["_bad"] == 1.0 or not finite:
             x = st.x.to_numpy()
-            score = -np.isfinite(x.sum(axis=1) + st.T.to_numpy() + st.J.to_numpy())
+            score = (~np.isfinite(x.sum(axis=1) + st.T.to_numpy() + st.J.to_numpy())).astype(float)
             problem = (f"NaN or infinity in the point state, first at {self._where(score)}", hint)
         elif internal["_bad"] == 2.0:
             x = st.x.to_numpy()

@@ -1,4 +1,7 @@
-"""Property-based tests: broken and extreme case files stop with the project's own error."""
+"""Property-based tests: broken and extreme case files stop with the project's own error.
+
+Derandomized, so that CI runs the same examples every time and a failure reproduces; a
+randomized run found the guard's NaN-location bug (fixed, tests/test_run.py)."""
 
 import math
 
@@ -57,7 +60,9 @@ def _set(data: dict, path: tuple, value) -> dict:
     return out
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 @given(st.lists(st.tuples(st.sampled_from(PATHS), values), min_size=1, max_size=4))
 def test_mutated_cases_load_or_fail_clearly(mutations):
     data = BASE
@@ -74,7 +79,7 @@ def test_mutated_cases_load_or_fail_clearly(mutations):
         assert msg and "=" in msg or "unknown key" in msg or "required" in msg, msg
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=100, deadline=None, derandomize=True)
 @given(
     st.floats(min_value=-1e3, max_value=1e3),
     st.floats(min_value=-1e3, max_value=1e3),
@@ -93,7 +98,9 @@ def test_any_disc_is_inside_or_refused(cx, cy, r):
     assert n > 0
 
 
-@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=6, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 @given(
     power=st.floats(min_value=0.0, max_value=500.0),
     radius=st.floats(min_value=1.0, max_value=500.0),

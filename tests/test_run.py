@@ -130,3 +130,16 @@ def test_guard_catches_an_unstable_thermal_step():
             err = str(e)
             break
     assert err is not None and "outside the physical range" in err and "thermal" in err
+
+
+def test_guard_names_the_point_that_went_nan():
+    sim = Simulation(_small())
+    T = sim.state.T.to_numpy()
+    T[17] = np.nan
+    sim.state.T.from_numpy(T)
+    try:
+        sim.monitors()
+    except SimulationError as e:
+        assert "NaN" in str(e) and "point 17 " in str(e)
+    else:
+        raise AssertionError("the guard let a NaN temperature through")
