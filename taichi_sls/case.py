@@ -420,15 +420,21 @@ def case_from_dict(data: dict) -> Case:
     return case
 
 
+def read_toml(path: str | Path, what: str, error: type[Exception] = CaseError) -> dict:
+    """Parse a TOML file, turning a missing file or bad syntax into ``error`` with the path."""
+    path = Path(path)
+    if not path.is_file():
+        raise error(f"{what} {str(path)!r} does not exist")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise error(f"{path}: not valid TOML: {e}") from None
+
+
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
     """Read a case file, apply ``--set`` overrides, validate, return the :class:`Case`."""
     path = Path(path)
-    if not path.is_file():
-        raise CaseError(f"case file {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise CaseError(f"{path}: not valid TOML: {e}") from None
+    data = read_toml(path, "case file")
     for o in overrides or []:
         apply_override(data, o)
     if "case" not in data or "name" not in data.get("case", {}):

@@ -66,12 +66,11 @@ import itertools
 import json
 import sys
 import time
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .case import CaseError, load_case
+from .case import CaseError, load_case, read_toml
 from .output import _atomic_path
 
 STATUS_FINAL = ("complete", "failed", "error")  # skipped on restart (without --retry)
@@ -167,12 +166,7 @@ def _axis(name: str, values: Any) -> list[dict[str, Any]]:
 def load_sweep(path: str | Path, extra_set: list[str] | None = None) -> Sweep:
     """Read and check a sweep file; ``extra_set`` overrides apply to every case after ``set``."""
     path = Path(path)
-    if not path.is_file():
-        raise SweepError(f"sweep file {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise SweepError(f"{path}: not valid TOML: {e}") from None
+    data = read_toml(path, "sweep file", SweepError)
     unknown = sorted(set(data) - {"sweep", "grid", "cases"})
     if unknown:
         raise SweepError(f"unknown table {unknown[0]!r}; allowed: sweep, grid, cases")
