@@ -102,11 +102,11 @@ def column_span(phi_col: np.ndarray, h: float) -> float:
     return float(y1 - y0)
 
 
-def contact_line(
-    phi: np.ndarray, h: float, off: int, x_left: float, x_right: float, span: bool = False
-) -> float:
-    """Narrowest material section (m) over node columns strictly between x_left and x_right.
-    With ``span``: the outer extent (holes included) of that same narrowest column."""
+def neck_measures(
+    phi: np.ndarray, h: float, off: int, x_left: float, x_right: float
+) -> tuple[float, float]:
+    """(contact line, neck span) in metres: the narrowest material section over the node columns
+    strictly between x_left and x_right, and the outer extent (holes included) of that column."""
     best, best_i = np.inf, -1
     for i in range(phi.shape[0]):
         x = (i - off) * h
@@ -115,8 +115,15 @@ def contact_line(
             if v < best:
                 best, best_i = v, i
     if best_i < 0:
-        return float("nan")
-    return column_span(phi[best_i], h) if span else float(best)
+        return float("nan"), float("nan")
+    return float(best), column_span(phi[best_i], h)
+
+
+def contact_line(
+    phi: np.ndarray, h: float, off: int, x_left: float, x_right: float, span: bool = False
+) -> float:
+    """The contact line of :func:`neck_measures` (with ``span``: the neck span)."""
+    return neck_measures(phi, h, off, x_left, x_right)[1 if span else 0]
 
 
 def body_centroids_x(x: np.ndarray, body: np.ndarray, mass: np.ndarray) -> list[float]:

@@ -12,7 +12,7 @@ import taichi as ti
 
 from .case import Case, CaseError
 from .materials import KELVIN, stability_limits
-from .monitor import body_centroids_x, contact_line, point_monitors
+from .monitor import body_centroids_x, neck_measures, point_monitors
 from .scene import Scene, build_scene
 from .state import State
 from .step import advance, level_set_only
@@ -92,6 +92,8 @@ class Simulation:
         coldest = min([float(self.scene.T0_C.min()), *walls])
         self._T_floor = coldest + KELVIN if case.physics.thermal else -math.inf
         self._centroid_pair = len(case.bodies) >= 2
+        self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
+        self._e_static: float | None = None  # the step-independent part of _energy_bound
 
     @property
     def t(self) -> float:
@@ -117,9 +119,7 @@ class Simulation:
         x = self.state.x.to_numpy()
         cx = body_centroids_x(x, self.scene.body, self._x_mass)
         lo, hi = sorted(cx[:2])
-        phi = self.phi()
-        h, off = self.state.h, self.state.off
-        return contact_line(phi, h, off, lo, hi), contact_line(phi, h, off, lo, hi, span=True)
+        return neck_measures(self.phi(), self.state.h, self.state.off, lo, hi)
 
     def monitors(self) -> dict[str, float]:
         """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard."""
@@ -134,7 +134,7 @@ class Simulation:
         cl, span = self.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6
-        if self.steps == 0 and not hasattr(self, "_H0"):
+        if self.steps == 0 and self._H0 is None:
             self._H0 = out["enthalpy_J_per_m"]
         self._guard(out, internal)
         return out
@@ -147,7 +147,7 @@ class Simulation:
 
     def _energy_error(self, mon: dict[str, float]) -> float:
         """(laser - heat out - enthalpy rise) / (initial enthalpy + laser): 0 up to round-off."""
-        if not hasattr(self, "_H0"):
+        if self._H0 is None:
             return 0.0
         rise = mon["enthalpy_J_per_m"] - self._H0
         net = mon["laser_energy_J_per_m"] - mon["heat_out_J_per_m"]
@@ -156,7 +156,7 @@ class Simulation:
     def _energy_bound(self) -> float:
         """Every energy a run can turn into motion: initial kinetic energy, surface energy of the
         bodies' outlines, potential energy across the domain, laser energy so far (J/m)."""
-        if not hasattr(self, "_e_static"):
+        if self._e_static is None:
             c = self.case
             perim = sum(
                 2 * math.pi * b.radius_um
