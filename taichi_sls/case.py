@@ -159,6 +159,18 @@ class Time:
     end_s: float = _opt(1e-3, positive=True, doc="simulated end time (s)")
     safety: float = _opt(0.4, positive=True, doc='fraction of the stability limit for "auto"')
     allow_unstable_dt: bool = _opt(False, doc="let a fixed dt exceed the stability limit")
+    heat_every: int | str = _opt(
+        "auto",
+        doc="conduction and laser every N mechanical steps, with a heat step of N dt (the "
+        'thermal limit is ~100x the elastic one); "auto": the largest N with N dt <= '
+        "heat_step_fraction x the thermal limit; 1: every step",
+    )
+    heat_step_fraction: float = _opt(
+        0.1,
+        positive=True,
+        maximum=1.0,
+        doc='heat step as a fraction of the thermal stability limit for heat_every = "auto"',
+    )
 
 
 @dataclass
@@ -176,6 +188,16 @@ class Solver:
     )
     flip_ratio: float = _opt(0.9, nonneg=True, doc="FLIP share of the pic_flip blend, in [0, 1]")
     arch: str = _opt("cpu", choices=("cpu", "gpu"), doc="Taichi backend")
+    layout: str = _opt(
+        "auto",
+        choices=("auto", "serial", "parallel"),
+        doc="serial: many steps per kernel call, loops serialized (small scenes on CPU); "
+        "parallel: one call per step, every stage a parallel loop (GPU, large scenes); auto: "
+        "serial on CPU below solver.parallel_points points",
+    )
+    parallel_points: int = _opt(
+        20000, positive=True, doc='points from which "auto" picks the parallel layout on CPU'
+    )
     precision: str = _opt("f64", choices=("f64", "f32"), doc="floating point precision")
     small_mass: float = _opt(
         1e-9, nonneg=True, doc="nodes below this fraction of a full cell's mass are skipped"
@@ -259,6 +281,19 @@ class SurfaceTension:
     )
     curvature_cap_h: float = _opt(
         0.5, nonneg=True, doc="|kappa| h capped here (0 = no cap); the grid resolves R >= 2h"
+    )
+    curvature_every: int | str = _opt(
+        "auto",
+        doc="rebuild level set and curvature every N steps (the CSF force uses the current mass "
+        'every step); "auto": the largest N with N dt <= curvature_step_fraction x the '
+        "capillary limit. A stale curvature is a delayed restoring force: every 10 steps on "
+        "the paper's fine grid (N dt = the capillary limit) doubled the kinetic energy",
+    )
+    curvature_step_fraction: float = _opt(
+        0.25,
+        positive=True,
+        maximum=1.0,
+        doc='curvature age as a fraction of the capillary limit for curvature_every = "auto"',
     )
 
 
@@ -500,6 +535,12 @@ def validate(case: Case) -> None:
         raise CaseError(f'time.dt_s = {dt!r}: expected a positive number or "auto"')
     if isinstance(dt, float) and not dt > 0:
         raise CaseError(f"time.dt_s = {dt}: must be > 0")
+    for key, v in (
+        ("time.heat_every", case.time.heat_every),
+        ("surface_tension.curvature_every", case.surface_tension.curvature_every),
+    ):
+        if (isinstance(v, str) and v != "auto") or (isinstance(v, int) and v < 1):
+            raise CaseError(f'{key} = {v!r}: expected an integer >= 1 or "auto"')
     if not 0 <= case.solver.flip_ratio <= 1:
         raise CaseError(f"solver.flip_ratio = {case.solver.flip_ratio}: must lie in [0, 1]")
     for i, las in enumerate(case.lasers):

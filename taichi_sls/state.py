@@ -20,9 +20,19 @@ LASER_PARAMS = ("on", "off", "x0", "speed", "x_end", "top", "amp", "r0", "eta", 
 LP = {n: i for i, n in enumerate(LASER_PARAMS)}
 
 
+def parallel_layout(case: Case, n_points: int) -> bool:
+    """One parallel kernel call per step (True) or many serialized steps per call (False)."""
+    lay = case.solver.layout
+    if lay == "auto":
+        return case.solver.arch == "gpu" or n_points >= case.solver.parallel_points
+    return lay == "parallel"
+
+
 @ti.data_oriented
 class State:
-    def __init__(self, case: Case, scene: Scene) -> None:
+    def __init__(
+        self, case: Case, scene: Scene, heat_every: int = 1, curvature_every: int = 1
+    ) -> None:
         dim = 2
         self.dim = dim
         self.case = case
@@ -36,6 +46,7 @@ class State:
         self.ncx = int(round(scene.width / scene.h))
         self.ncy = int(round(scene.height / scene.h))
 
+        self.parallel = parallel_layout(case, n)
         ph = case.physics
         self.mech = ph.mechanics
         self.thermal = ph.thermal
@@ -61,6 +72,8 @@ class State:
         self.band = st.band_cells
         self.redistance = st.level_set == "redistanced"
         self.smooth_passes = st.smoothing_passes
+        self.geom_every = curvature_every if self.surface else 1
+        self.heat_every = heat_every if self.thermal else 1
         self.blur_passes = st.level_set_smoothing_passes
         self.zero_net_force = st.zero_net_force
         self.csf_c0 = st.colour_threshold
@@ -86,6 +99,7 @@ class State:
         self.eps_pl = ti.Matrix.field(3, 3, float, n)  # plastic strain (plane strain: 3x3)
         self.alpha = ti.field(float, n)  # equivalent plastic strain (eq. 43)
         self.e_iso = ti.field(float, n)  # thermal + transformation strain, isotropic (eqs. 36-37)
+        self.de_iso = ti.field(float, n)  # its increment per mechanical step
         self.sigma = ti.Matrix.field(3, 3, float, n)
         self.vol0 = ti.field(float, n)
         self.J = ti.field(float, n)
@@ -117,6 +131,7 @@ class State:
         self.nseg = ti.field(ti.i32, (scene.nx - 1, scene.ny - 1))
         # ---- scalars and parameter tables
         self.t = ti.field(float, ())
+        self.step = ti.field(ti.i32, ())  # steps taken: the phase of the heat and curvature clocks
         self.dt = ti.field(float, ())
         self.laser_energy = ti.field(float, ())
         self.heat_out = ti.field(float, ())
@@ -162,6 +177,7 @@ class State:
             self.sigma[p] = ti.Matrix.zero(float, 3, 3)
             self.alpha[p] = 0.0
             self.e_iso[p] = 0.0
+            self.de_iso[p] = 0.0
             self.H[p] = enthalpy(self.matp, self.mat[p], self.T[p])
             self.xi[p] = solid_fraction(self.matp, self.mat[p], self.T[p])
 

@@ -28,7 +28,16 @@ from .mechanics import (
 )
 from .shape import stencil
 from .state import State
-from .surface import level_set, scatter_level_set, surface_forces
+from .surface import (
+    blur_level_set,
+    csf_force,
+    curvature,
+    extend_and_smooth,
+    level_set,
+    mass_gradient,
+    scatter_level_set,
+    surface_geometry,
+)
 from .thermal import g2p_heat, grid_heat, grid_temperature, p2g_heat_capacity, p2g_heat_flux
 
 
@@ -43,54 +52,60 @@ def _stencil(st: ti.template(), p):
 
 
 @ti.func
-def clear_grid(st: ti.template()):
+def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
     for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
         st.gm[I] = 0.0
         st.gmv[I] = ti.Vector.zero(float, st.dim)
         st.gf[I] = ti.Vector.zero(float, st.dim)
         if ti.static(st.thermal):
-            st.gcap[I] = 0.0
-            st.gcT[I] = 0.0
-            st.gQ[I] = 0.0
+            if heat:
+                st.gcap[I] = 0.0
+                st.gcT[I] = 0.0
+                st.gQ[I] = 0.0
         if ti.static(st.surface):
-            st.phi_raw[I] = st.phi_cap
+            if geom:
+                st.phi_raw[I] = st.phi_cap
 
 
 @ti.func
-def p2g(st: ti.template()):
+def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
     for p in range(st.n_points):
         base, w, dw = _stencil(st, p)
         if ti.static(st.mech):
             p2g_mechanics(st, p, base, w, dw)
         if ti.static(st.thermal):
-            p2g_heat_capacity(st, p, base, w, dw)
+            if heat:
+                p2g_heat_capacity(st, p, base, w, dw)
         if ti.static(st.surface):
-            scatter_level_set(st, p, base)
+            if geom:
+                scatter_level_set(st, p, base)
 
 
 @ti.func
-def grid_prepare(st: ti.template(), dt):
+def grid_prepare(st: ti.template(), heat: ti.template()):
     for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
         if ti.static(st.mech):
             grid_velocity(st, I, 0.0)  # v^n only; forces are not complete yet
         if ti.static(st.thermal):
-            grid_temperature(st, I)
+            if heat:
+                grid_temperature(st, I)
 
 
 @ti.func
-def p2g_heat(st: ti.template(), t, dt):
+def p2g_heat(st: ti.template(), t, dt_heat):
     for p in range(st.n_points):
         base, w, dw = _stencil(st, p)
-        p2g_heat_flux(st, p, base, w, dw, t, dt)
+        p2g_heat_flux(st, p, base, w, dw, t, dt_heat)
 
 
 @ti.func
-def grid_update(st: ti.template(), dt):
+def grid_update(st: ti.template(), dt, heat: ti.template(), dt_heat):
     for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
         if ti.static(st.mech):
             grid_velocity(st, I, dt)
         if ti.static(st.thermal):
-            grid_heat(st, I, dt)
+            if heat:
+                grid_heat(st, I, dt_heat)
 
 
 @ti.func
@@ -117,16 +132,24 @@ def constitutive(st: ti.template(), p, L, dt):
 
 
 @ti.func
-def g2p_point(st: ti.template(), p, base, w, dw, dt, kinematics: ti.template()):
+def g2p_point(
+    st: ti.template(), p, base, w, dw, dt, kinematics: ti.template(), heat: ti.template()
+):
     """Heat, thermal strains and velocity of point p; with ``kinematics`` (USL) also its motion
     and stress."""
     if ti.static(st.thermal):
-        dT, dxi = g2p_heat(st, p, base, w, dw)
+        if heat:
+            dT, dxi = g2p_heat(st, p, base, w, dw)
+            if ti.static(st.th_strain and st.mech):
+                # eqs. 36-37: alpha at the step's mean solid fraction. The increment of one heat
+                # step is spread over the heat_every mechanical steps that follow: added at once
+                # it is an impulse that rings the elastic melt (the scan case's kinetic energy
+                # tripled with heat every 19 steps)
+                m = st.mat[p]
+                alpha = lerp_phase(st.matp, m, st.xi[p] - 0.5 * dxi, "alpha_c", "alpha_m")
+                st.de_iso[p] = (alpha * dT + st.matp[m, P["beta"]] * dxi) / st.heat_every
         if ti.static(st.th_strain and st.mech):
-            # eqs. 36-37: alpha at the step's mean solid fraction
-            m = st.mat[p]
-            alpha = lerp_phase(st.matp, m, st.xi[p] - 0.5 * dxi, "alpha_c", "alpha_m")
-            st.e_iso[p] += alpha * dT + st.matp[m, P["beta"]] * dxi
+            st.e_iso[p] += st.de_iso[p]
     if ti.static(st.mech):
         g2p_velocity(st, p, base, w, dw)
         if ti.static(kinematics):
@@ -134,10 +157,10 @@ def g2p_point(st: ti.template(), p, base, w, dw, dt, kinematics: ti.template()):
 
 
 @ti.func
-def g2p(st: ti.template(), dt):
+def g2p(st: ti.template(), dt, heat: ti.template()):
     for p in range(st.n_points):
         base, w, dw = _stencil(st, p)
-        g2p_point(st, p, base, w, dw, dt, not st.musl)
+        g2p_point(st, p, base, w, dw, dt, not st.musl, heat)
     if ti.static(st.musl and st.mech):
         for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
             st.gmv[I] = ti.Vector.zero(float, st.dim)
@@ -152,19 +175,40 @@ def g2p(st: ti.template(), dt):
 
 
 @ti.func
-def substep(st: ti.template()):
+def substep(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """One mechanical step. ``heat``: conduction and laser this step, over heat_every * dt (the
+    thermal clock); ``geom``: level set and curvature this step (reused for curvature_every
+    steps; the CSF force itself is rebuilt from the current mass every step). Both are Python
+    bools in the GPU layout (the stages compile in or out) and runtime flags in the CPU one."""
     dt = st.dt[None]
     t = st.t[None]
-    clear_grid(st)
-    p2g(st)
-    grid_prepare(st, dt)
+    dt_heat = dt * st.heat_every
+    clear_grid(st, heat, geom)
+    p2g(st, heat, geom)
+    grid_prepare(st, heat)
     if ti.static(st.surface):
-        surface_forces(st)
+        if ti.static(isinstance(geom, bool)):
+            if ti.static(geom):
+                surface_geometry(st)
+            else:
+                mass_gradient(st)
+        else:
+            if geom:
+                surface_geometry(st)
+            else:
+                mass_gradient(st)
+        csf_force(st)
     if ti.static(st.thermal):
-        p2g_heat(st, t, dt)
-    grid_update(st, dt)
-    g2p(st, dt)
+        if ti.static(isinstance(heat, bool)):
+            if ti.static(heat):
+                p2g_heat(st, t, dt_heat)
+        else:
+            if heat:
+                p2g_heat(st, t, dt_heat)
+    grid_update(st, dt, heat, dt_heat)
+    g2p(st, dt, heat)
     st.t[None] = t + dt
+    st.step[None] += 1
 
 
 @ti.kernel
@@ -172,13 +216,14 @@ def advance_serial(st: ti.template(), n: ti.i32):
     """CPU layout: n steps in one call."""
     ti.loop_config(serialize=True)
     for _ in range(n):
-        substep(st)
+        k = st.step[None]
+        substep(st, k % st.heat_every == 0, k % st.geom_every == 0)
 
 
 @ti.kernel
-def advance_one(st: ti.template()):
+def advance_one(st: ti.template(), heat: ti.template(), geom: ti.template()):
     """GPU layout: one step per call, each stage a parallel loop."""
-    substep(st)
+    substep(st, heat, geom)
 
 
 @ti.kernel
@@ -192,10 +237,13 @@ def level_set_only(st: ti.template()):
     level_set(st)
 
 
-def advance(st: State, n: int, gpu: bool) -> None:
-    if gpu:
-        for _ in range(n):
-            advance_one(st)
+def advance(st: State, n: int) -> None:
+    """n steps in the state's layout: serial (one call) or parallel (one call per step). The
+    layout is fixed when the state is made: it decides which loops are unrolled."""
+    if st.parallel:
+        k = int(st.step[None])
+        for i in range(k, k + n):
+            advance_one(st, i % st.heat_every == 0, i % st.geom_every == 0)
     else:
         advance_serial(st, n)
 
@@ -204,6 +252,97 @@ def advance(st: State, n: int, gpu: bool) -> None:
 def surface_only(st: ti.template()):
     """Grid mass, level set, curvature and CSF force of the current points, without a step
     (diagnostics and verification)."""
-    clear_grid(st)
-    p2g(st)
-    surface_forces(st)
+    clear_grid(st, True, True)
+    p2g(st, True, True)
+    surface_geometry(st)
+    csf_force(st)
+
+
+# ---- the same step laid out as one kernel call per stage: the speed benchmark's comparison
+@ti.kernel
+def _k_clear(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    clear_grid(st, heat, geom)
+
+
+@ti.kernel
+def _k_p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    p2g(st, heat, geom)
+
+
+@ti.kernel
+def _k_grid_prepare(st: ti.template(), heat: ti.template()):
+    grid_prepare(st, heat)
+
+
+@ti.kernel
+def _k_level_set(st: ti.template()):
+    level_set(st)
+
+
+@ti.kernel
+def _k_blur(st: ti.template()):
+    blur_level_set(st)
+
+
+@ti.kernel
+def _k_curvature(st: ti.template()):
+    curvature(st)
+
+
+@ti.kernel
+def _k_mass_gradient(st: ti.template()):
+    mass_gradient(st)
+
+
+@ti.kernel
+def _k_extend(st: ti.template()):
+    extend_and_smooth(st)
+
+
+@ti.kernel
+def _k_csf(st: ti.template()):
+    csf_force(st)
+
+
+@ti.kernel
+def _k_p2g_heat(st: ti.template()):
+    dt = st.dt[None]
+    p2g_heat(st, st.t[None], dt * st.heat_every)
+
+
+@ti.kernel
+def _k_grid_update(st: ti.template(), heat: ti.template()):
+    dt = st.dt[None]
+    grid_update(st, dt, heat, dt * st.heat_every)
+
+
+@ti.kernel
+def _k_g2p(st: ti.template(), heat: ti.template()):
+    g2p(st, st.dt[None], heat)
+    st.t[None] += st.dt[None]
+    st.step[None] += 1
+
+
+def advance_staged(st: State, n: int) -> None:
+    """n steps, every stage its own kernel call (13 per step with surface tension and heat)."""
+    if not st.parallel:
+        raise ValueError("advance_staged needs a state made with the parallel layout")
+    k = int(st.step[None])
+    for i in range(k, k + n):
+        heat, geom = i % st.heat_every == 0, i % st.geom_every == 0
+        _k_clear(st, heat, geom)
+        _k_p2g(st, heat, geom)
+        _k_grid_prepare(st, heat)
+        if st.surface:
+            if geom:
+                _k_level_set(st)
+                _k_blur(st)
+                _k_curvature(st)
+            _k_mass_gradient(st)
+            if geom:
+                _k_extend(st)
+            _k_csf(st)
+        if st.thermal and heat:
+            _k_p2g_heat(st)
+        _k_grid_update(st, heat)
+        _k_g2p(st, heat)

@@ -148,17 +148,28 @@ def blur_level_set(st: ti.template()):
     phi itself stays unsmoothed for the contact line."""
     for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
         st.phis[I] = st.phi[I]
-    for _ in ti.static(range(st.blur_passes)):
-        for i, j in ti.ndrange(st.nx, st.ny):
-            v = st.phis[i, j]
-            if i > 0 and i < st.nx - 1:
-                v = 0.25 * (st.phis[i - 1, j] + st.phis[i + 1, j]) + 0.5 * v
-            st.ktmp[i, j] = v
-        for i, j in ti.ndrange(st.nx, st.ny):
-            v = st.ktmp[i, j]
-            if j > 0 and j < st.ny - 1:
-                v = 0.25 * (st.ktmp[i, j - 1] + st.ktmp[i, j + 1]) + 0.5 * v
-            st.phis[i, j] = v
+    # passes unrolled only where each loop must stay a top-level parallel loop: unrolled, the
+    # serial step kernel grows by two loops a pass and Taichi's optimiser slows down with it
+    if ti.static(st.parallel):
+        for _ in ti.static(range(st.blur_passes)):
+            _blur_pass(st)
+    else:
+        for _ in range(st.blur_passes):
+            _blur_pass(st)
+
+
+@ti.func
+def _blur_pass(st: ti.template()):
+    for i, j in ti.ndrange(st.nx, st.ny):
+        v = st.phis[i, j]
+        if i > 0 and i < st.nx - 1:
+            v = 0.25 * (st.phis[i - 1, j] + st.phis[i + 1, j]) + 0.5 * v
+        st.ktmp[i, j] = v
+    for i, j in ti.ndrange(st.nx, st.ny):
+        v = st.ktmp[i, j]
+        if j > 0 and j < st.ny - 1:
+            v = 0.25 * (st.ktmp[i, j - 1] + st.ktmp[i, j + 1]) + 0.5 * v
+        st.phis[i, j] = v
 
 
 @ti.func
@@ -217,8 +228,10 @@ def mass_gradient(st: ti.template()):
                 m = st.gm[i + a - 1, j + b - 1]
                 g += m * ti.Vector([dS[a] * S[b], S[a] * dS[b]])
         st.gradm[i, j] = g
+        iface = 0
         if st.gm[i, j] > st.mass_cut and g.norm() * st.h > 1e-6 * st.rho_ref * st.cell_volume:
-            st.kvalid[i, j] |= 2
+            iface = 2
+        st.kvalid[i, j] = (st.kvalid[i, j] & 1) | iface
 
 
 @ti.func
@@ -236,26 +249,35 @@ def extend_and_smooth(st: ti.template()):
                     n += 1
             k = s / n if n > 0 else 0.0
         st.ktmp[i, j] = k
-    for _ in ti.static(range(st.smooth_passes)):
-        for i, j in ti.ndrange(st.nx, st.ny):
-            k = st.ktmp[i, j]
-            if st.kvalid[i, j] & 2 and i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
-                s = 0.0
-                w = 0.0
-                for a, b in ti.static(ti.ndrange(3, 3)):
-                    if st.kvalid[i + a - 1, j + b - 1] & 2:
-                        m = st.gm[i + a - 1, j + b - 1]
-                        s += m * st.ktmp[i + a - 1, j + b - 1]
-                        w += m
-                k = s / w
-            st.kappa[i, j] = k
-        for i, j in ti.ndrange(st.nx, st.ny):
-            st.ktmp[i, j] = st.kappa[i, j]
+    if ti.static(st.parallel):
+        for _ in ti.static(range(st.smooth_passes)):
+            _smooth_pass(st)
+    else:
+        for _ in range(st.smooth_passes):
+            _smooth_pass(st)
     for i, j in ti.ndrange(st.nx, st.ny):
         k = st.ktmp[i, j]
         if ti.static(st.kappa_cap > 0.0):
             k = ti.min(st.kappa_cap, ti.max(-st.kappa_cap, k))
         st.kappa[i, j] = k
+
+
+@ti.func
+def _smooth_pass(st: ti.template()):
+    for i, j in ti.ndrange(st.nx, st.ny):
+        k = st.ktmp[i, j]
+        if st.kvalid[i, j] & 2 and i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
+            s = 0.0
+            w = 0.0
+            for a, b in ti.static(ti.ndrange(3, 3)):
+                if st.kvalid[i + a - 1, j + b - 1] & 2:
+                    m = st.gm[i + a - 1, j + b - 1]
+                    s += m * st.ktmp[i + a - 1, j + b - 1]
+                    w += m
+            k = s / w
+        st.kappa[i, j] = k
+    for i, j in ti.ndrange(st.nx, st.ny):
+        st.ktmp[i, j] = st.kappa[i, j]
 
 
 @ti.func
@@ -297,10 +319,10 @@ def level_set(st: ti.template()):
 
 
 @ti.func
-def surface_forces(st: ti.template()):
+def surface_geometry(st: ti.template()):
+    """Level set, curvature and interface nodes; the CSF force (``csf_force``) follows."""
     level_set(st)
     blur_level_set(st)
     curvature(st)
     mass_gradient(st)
     extend_and_smooth(st)
-    csf_force(st)

@@ -68,19 +68,34 @@ def grid_temperature(st: ti.template(), I):
 
 
 @ti.func
-def laser_source(st: ti.template(), xp, t):
-    """Eq. 31 (MODEL.md reading): power per unit volume at xp, summed over the lasers on."""
+def laser_source(st: ti.template(), xp, t, dt):
+    """Eq. 31 (MODEL.md reading): mean power per unit volume at xp over [t, t + dt], summed over
+    the lasers. Each beam's on-time within the step is exact (a heat step may span many
+    mechanical steps and a switch-on or -off), its position taken at the middle of that time."""
     s = 0.0
     for k in range(st.n_lasers):
         on = st.lasp[k, LP["on"]]
-        xl = st.lasp[k, LP["x0"]] + st.lasp[k, LP["speed"]] * (t - on)
-        if t >= on and t < st.lasp[k, LP["off"]] and xl <= st.lasp[k, LP["x_end"]]:
+        x0 = st.lasp[k, LP["x0"]]
+        speed = st.lasp[k, LP["speed"]]
+        x_end = st.lasp[k, LP["x_end"]]
+        t0 = ti.max(t, on)
+        t1 = ti.min(t + dt, st.lasp[k, LP["off"]])
+        # the beam is off while its centre x0 + speed (t - on) lies beyond x_end
+        if speed > 0.0:
+            t1 = ti.min(t1, on + (x_end - x0) / speed)
+        elif speed < 0.0:
+            t0 = ti.max(t0, on + (x_end - x0) / speed)
+        elif x0 > x_end:
+            t1 = t0
+        if t1 > t0:
+            xl = x0 + speed * (0.5 * (t0 + t1) - on)
             r0 = st.lasp[k, LP["r0"]]
             eta = st.lasp[k, LP["eta"]]
             depth = ti.max(st.lasp[k, LP["top"]] - xp[1], 0.0)
             dx = xl - xp[0]
             s += (
                 st.lasp[k, LP["amp"]]
+                * ((t1 - t0) / dt)
                 * ti.exp(-2.0 * dx * dx / (r0 * r0))
                 * ti.exp(-st.lasp[k, LP["sign"]] * depth / eta)
             )
@@ -99,7 +114,7 @@ def p2g_heat_flux(st: ti.template(), p, base, w, dw, t, dt):
     Vp = st.vol0[p] * st.J[p]
     s = 0.0
     if ti.static(st.laser):
-        s = laser_source(st, st.x[p], t)
+        s = laser_source(st, st.x[p], t, dt)
         st.laser_energy[None] += Vp * s * dt
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
