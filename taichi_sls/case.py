@@ -195,6 +195,11 @@ class Solver:
         "parallel: one call per step, every stage a parallel loop (GPU, large scenes); auto: "
         "serial on CPU below solver.parallel_points points",
     )
+    active_region: bool = _opt(
+        True,
+        doc="grid loops only over the nodes that material has reached (plus the stencil, "
+        "level-set band and smoothing margin); false: every node, every step",
+    )
     parallel_points: int = _opt(
         20000, positive=True, doc='points from which "auto" picks the parallel layout on CPU'
     )

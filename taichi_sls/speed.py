@@ -49,6 +49,8 @@ SWITCHES = {
     "no heat (mechanics only)": ["physics.thermal=false"],
     "no mechanics (heat only)": ["physics.mechanics=false"],
     "f32": ["solver.precision=f32"],
+    "domain 4x taller, active region": ["domain.height_um=192"],
+    "domain 4x taller, every node": ["domain.height_um=192", "solver.active_region=false"],
 }
 
 

@@ -28,6 +28,14 @@ def parallel_layout(case: Case, n_points: int) -> bool:
     return lay == "parallel"
 
 
+@ti.func
+def active(st: ti.template(), shrink: ti.template() = 0):
+    """Index ranges of the active region (``solver.active_region``) for ti.ndrange; ``shrink``
+    drops that many nodes at the upper end (1: cells between active nodes)."""
+    b = st.box[None]
+    return (b[0], b[2] - shrink), (b[1], b[3] - shrink)
+
+
 @ti.data_oriented
 class State:
     def __init__(
@@ -79,6 +87,10 @@ class State:
         self.csf_c0 = st.colour_threshold
         self.kappa_cap = st.curvature_cap_h / scene.h if st.curvature_cap_h > 0 else 0.0
         self.phi_cap = (st.band_cells + 1) * scene.h
+        self.active_region = case.solver.active_region
+        # nodes beyond the points' footprint that the full-grid step would still change: the
+        # level-set band and the blur's reach, plus one for the 3x3 fits
+        self.box_margin = st.band_cells + st.level_set_smoothing_passes + 2 if self.surface else 0
 
         first = case.materials[case.bodies[0].material]
         self.rho_ref = first.density_kg_m3
@@ -142,6 +154,7 @@ class State:
         self.fit = ti.Matrix.field(6, 9, float, ())  # least-squares fit of eq. 23
         self.red = ti.field(float, 12)  # reductions for monitors
         self.red_f = ti.Vector.field(3, float, ())  # CSF resultant and interface mass
+        self.box = ti.Vector.field(4, ti.i32, ())  # active region [i0, j0, i1, j1)
         self._vec, self._mat2, self._mat3 = vec, mat2, mat3
         self._fill()
 
@@ -160,6 +173,11 @@ class State:
         self.mat.from_numpy(sc.material)
         self.T.from_numpy(sc.T0_C + KELVIN)
         self.fit[None] = _fit_matrix()
+        # outside the active region the grid keeps these: empty, and outside every body
+        for f in (self.phi_raw, self.phi, self.phis):
+            f.fill(self.phi_cap)
+        full = [0, 0, self.nx, self.ny]
+        self.box[None] = [self.nx, self.ny, 0, 0] if self.active_region else full
         if self.n_lasers:
             self.lasp.from_numpy(_laser_rows(case, sc))
         self.t[None] = 0.0

@@ -27,7 +27,7 @@ from .mechanics import (
     p2g_momentum,
 )
 from .shape import stencil
-from .state import State
+from .state import State, active
 from .surface import (
     blur_level_set,
     csf_force,
@@ -52,8 +52,23 @@ def _stencil(st: ti.template(), p):
 
 
 @ti.func
+def update_box(st: ti.template()):
+    """Grow the active region to hold every point's level-set footprint (5x5 nodes) plus
+    ``box_margin`` nodes; grid loops run over it only. It never shrinks, so no node outside it
+    has ever been written: there every field keeps its empty initial value."""
+    if ti.static(st.active_region):
+        m = ti.static(st.box_margin)
+        for p in range(st.n_points):
+            base = ti.cast(ti.floor(st.x[p] * st.inv_h + 0.5), ti.i32) - 1 + st.off
+            ti.atomic_min(st.box[None][0], ti.max(base[0] - 1 - m, 0))
+            ti.atomic_min(st.box[None][1], ti.max(base[1] - 1 - m, 0))
+            ti.atomic_max(st.box[None][2], ti.min(base[0] + 4 + m, st.nx))
+            ti.atomic_max(st.box[None][3], ti.min(base[1] + 4 + m, st.ny))
+
+
+@ti.func
 def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+    for I in ti.grouped(ti.ndrange(*active(st))):
         st.gm[I] = 0.0
         st.gmv[I] = ti.Vector.zero(float, st.dim)
         st.gf[I] = ti.Vector.zero(float, st.dim)
@@ -83,7 +98,7 @@ def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 @ti.func
 def grid_prepare(st: ti.template(), heat: ti.template()):
-    for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+    for I in ti.grouped(ti.ndrange(*active(st))):
         if ti.static(st.mech):
             grid_velocity(st, I, 0.0)  # v^n only; forces are not complete yet
         if ti.static(st.thermal):
@@ -100,7 +115,7 @@ def p2g_heat(st: ti.template(), t, dt_heat):
 
 @ti.func
 def grid_update(st: ti.template(), dt, heat: ti.template(), dt_heat):
-    for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+    for I in ti.grouped(ti.ndrange(*active(st))):
         if ti.static(st.mech):
             grid_velocity(st, I, dt)
         if ti.static(st.thermal):
@@ -162,12 +177,12 @@ def g2p(st: ti.template(), dt, heat: ti.template()):
         base, w, dw = _stencil(st, p)
         g2p_point(st, p, base, w, dw, dt, not st.musl, heat)
     if ti.static(st.musl and st.mech):
-        for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+        for I in ti.grouped(ti.ndrange(*active(st))):
             st.gmv[I] = ti.Vector.zero(float, st.dim)
         for p in range(st.n_points):
             base, w, dw = _stencil(st, p)
             p2g_momentum(st, p, base, w, dw)
-        for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+        for I in ti.grouped(ti.ndrange(*active(st))):
             grid_remap_velocity(st, I)
         for p in range(st.n_points):
             base, w, dw = _stencil(st, p)
@@ -183,6 +198,7 @@ def substep(st: ti.template(), heat: ti.template(), geom: ti.template()):
     dt = st.dt[None]
     t = st.t[None]
     dt_heat = dt * st.heat_every
+    update_box(st)
     clear_grid(st, heat, geom)
     p2g(st, heat, geom)
     grid_prepare(st, heat)
@@ -228,7 +244,8 @@ def advance_one(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 @ti.kernel
 def level_set_only(st: ti.template()):
-    """The level set for monitors when surface tension is off."""
+    """The level set of the current points, for monitors."""
+    update_box(st)
     for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
         st.phi_raw[I] = st.phi_cap
     for p in range(st.n_points):
@@ -252,6 +269,7 @@ def advance(st: State, n: int) -> None:
 def surface_only(st: ti.template()):
     """Grid mass, level set, curvature and CSF force of the current points, without a step
     (diagnostics and verification)."""
+    update_box(st)
     clear_grid(st, True, True)
     p2g(st, True, True)
     surface_geometry(st)

@@ -32,6 +32,8 @@ The method, and why (MODEL.md, last section):
 
 import taichi as ti
 
+from .state import active
+
 
 @ti.func
 def scatter_level_set(st: ti.template(), p, base):
@@ -51,7 +53,7 @@ def _crossing(pa, pb, fa, fb):
 @ti.func
 def contour_segments(st: ti.template()):
     """Marching squares on phi_raw: up to two segments per cell, in metres."""
-    for i, j in ti.ndrange(st.nx - 1, st.ny - 1):
+    for i, j in ti.ndrange(*active(st, 1)):
         f = ti.Vector(
             [st.phi_raw[i, j], st.phi_raw[i + 1, j], st.phi_raw[i + 1, j + 1], st.phi_raw[i, j + 1]]
         )
@@ -120,7 +122,7 @@ def _seg_dist2(x, a, b):
 def redistance(st: ti.template()):
     """Signed distance to the contour segments for every node within the band."""
     nb = ti.static(st.band)
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         f = st.phi_raw[i, j]
         out = f
         if ti.static(st.redistance):
@@ -146,7 +148,7 @@ def blur_level_set(st: ti.template()):
     (a Gaussian of variance passes * h^2 / 2 per axis): removes the points' staircase before
     eq. 24 amplifies it. For a disc it moves the interface inward by about that variance / (2R).
     phi itself stays unsmoothed for the contact line."""
-    for I in ti.grouped(ti.ndrange(st.nx, st.ny)):
+    for I in ti.grouped(ti.ndrange(*active(st))):
         st.phis[I] = st.phi[I]
     # passes unrolled only where each loop must stay a top-level parallel loop: unrolled, the
     # serial step kernel grows by two loops a pass and Taichi's optimiser slows down with it
@@ -160,12 +162,12 @@ def blur_level_set(st: ti.template()):
 
 @ti.func
 def _blur_pass(st: ti.template()):
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         v = st.phis[i, j]
         if i > 0 and i < st.nx - 1:
             v = 0.25 * (st.phis[i - 1, j] + st.phis[i + 1, j]) + 0.5 * v
         st.ktmp[i, j] = v
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         v = st.ktmp[i, j]
         if j > 0 and j < st.ny - 1:
             v = 0.25 * (st.ktmp[i, j - 1] + st.ktmp[i, j + 1]) + 0.5 * v
@@ -176,7 +178,7 @@ def _blur_pass(st: ti.template()):
 def curvature(st: ti.template()):
     """Eqs. 22-24 at every node whose 3x3 neighbourhood lies in the band (kvalid bit 0)."""
     h = st.h
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         k = 0.0
         ok = 0
         if i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
@@ -221,7 +223,7 @@ def _node_stencil_1d(h: float, lp: float) -> tuple[list[float], list[float]]:
 def mass_gradient(st: ti.template()):
     """Eq. 20 with the uGIMP gradient at node positions; marks interface nodes (kvalid bit 1)."""
     S, dS = ti.static(_node_stencil_1d(st.h, st.lp))
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         g = ti.Vector.zero(float, 2)
         if i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
             for a, b in ti.static(ti.ndrange(3, 3)):
@@ -238,7 +240,7 @@ def mass_gradient(st: ti.template()):
 def extend_and_smooth(st: ti.template()):
     """Give interface nodes without a valid curvature the mean of valid neighbours, then
     ``smoothing_passes`` mass-weighted 3x3 averages over interface nodes, then the cap."""
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         k = st.kappa[i, j]
         if st.kvalid[i, j] == 2 and i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
             s = 0.0
@@ -255,7 +257,7 @@ def extend_and_smooth(st: ti.template()):
     else:
         for _ in range(st.smooth_passes):
             _smooth_pass(st)
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         k = st.ktmp[i, j]
         if ti.static(st.kappa_cap > 0.0):
             k = ti.min(st.kappa_cap, ti.max(-st.kappa_cap, k))
@@ -264,7 +266,7 @@ def extend_and_smooth(st: ti.template()):
 
 @ti.func
 def _smooth_pass(st: ti.template()):
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         k = st.ktmp[i, j]
         if st.kvalid[i, j] & 2 and i > 0 and j > 0 and i < st.nx - 1 and j < st.ny - 1:
             s = 0.0
@@ -276,7 +278,7 @@ def _smooth_pass(st: ti.template()):
                     w += m
             k = s / w
         st.kappa[i, j] = k
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         st.ktmp[i, j] = st.kappa[i, j]
 
 
@@ -297,7 +299,7 @@ def csf_force(st: ti.template()):
     coef = st.gamma / (st.rho_ref * (1.0 - c0) * (1.0 - c0))
     if ti.static(st.zero_net_force):
         st.red_f[None] = ti.Vector.zero(float, 3)
-    for i, j in ti.ndrange(st.nx, st.ny):
+    for i, j in ti.ndrange(*active(st)):
         if st.kvalid[i, j] & 2:
             wc = 2.0 * ti.max(st.gm[i, j] / full - c0, 0.0)
             f = coef * st.kappa[i, j] * wc * st.gradm[i, j]
@@ -305,7 +307,7 @@ def csf_force(st: ti.template()):
             if ti.static(st.zero_net_force):
                 st.red_f[None] += ti.Vector([f[0], f[1], st.gm[i, j]])
     if ti.static(st.zero_net_force):
-        for i, j in ti.ndrange(st.nx, st.ny):
+        for i, j in ti.ndrange(*active(st)):
             if st.kvalid[i, j] & 2:
                 r = st.red_f[None]
                 st.gf[i, j] -= st.gm[i, j] / r[2] * ti.Vector([r[0], r[1]])
