@@ -1,6 +1,7 @@
 """Run every Table 2 case (fine and coarse) plus ``nolaser`` and tabulate what the paper reports.
 
     python benchmarks/paper_table.py [--out out/paper] [--optimize] [--only power25W ...]
+        [--set key=value ...]
 
 Each case writes its usual outputs to OUT/<case>/ (a case already complete there is read, not run
 again). Prints a Markdown table and writes OUT/table.csv: peak temperature, contact line and neck
@@ -27,6 +28,7 @@ def main() -> None:
     ap.add_argument("--out", default="out/paper")
     ap.add_argument("--optimize", action="store_true")
     ap.add_argument("--only", nargs="*")
+    ap.add_argument("--set", action="append", default=[], help="case override for every case")
     args = ap.parse_args()
     out = Path(args.out)
     names = [b + s for s in ("", "_coarse") for b in BASES] + ["nolaser"]
@@ -38,7 +40,7 @@ def main() -> None:
         summ = folder / "summary.json"
         s = json.loads(summ.read_text()) if summ.is_file() else None
         if s is None or s.get("status") != "complete":
-            sets = ["solver.optimize=true"] if args.optimize else []
+            sets = (["solver.optimize=true"] if args.optimize else []) + args.set
             case = load_case(ROOT / "cases" / f"{name}.toml", sets)
             s = run_case(case, folder, progress=False)
         fin, ini = s["final"], s["initial"]

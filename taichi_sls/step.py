@@ -1,17 +1,25 @@
-"""One explicit MPM step (update-stress-last), its stage order, and the two kernel layouts.
+"""One explicit MPM step (update-stress-last), its stage order, and the kernel layouts.
 
+    active region (grows to hold every point plus margins; the grid loops run over it only)
     clear grid
-    P2G        mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28); level set (eq. 21)
-    grid       v^n; node temperature (fixed-temperature walls)
-    surface    contour, redistance, curvature, grad m, CSF force (eqs. 19-24)
-    P2G heat   grad T_p, conduction and laser heat rates (eqs. 29-31)
-    grid       v^{n+1} with walls (eq. 13); dT_i
-    G2P        velocity, position, L, F, J (eqs. 14-18); enthalpy, T, xi_s (eqs. 32-33);
+    P2G        mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; level set (eq. 21)**
+    grid       v^n; node temperature (fixed-temperature walls)*
+    surface    contour, redistance, curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
+    P2G heat   grad T_p, conduction and laser heat rates (eqs. 29-31)*
+    grid       v^{n+1} with walls (eq. 13); dT_i*
+    G2P        velocity, position, L, F, J (eqs. 14-18); enthalpy, T, xi_s (eqs. 32-33)*;
                strain split and Perzyna return map (eqs. 34-45)
 
-CPU layout: many steps inside one kernel call with the step loop serialized (a kernel launch
-costs tens of microseconds; the paper's scene has a few thousand points). GPU layout: one kernel
-call per step, every stage a parallel loop.
+Two clocks skip what a step does not need. * Heat runs every ``heat_every`` steps with a heat
+step of heat_every * dt: conduction's stability limit is ~100x the elastic one, and its thermal
+strain increment is spread over the mechanical steps that follow. ** The level set and curvature
+are rebuilt every ``curvature_every`` steps (a fraction of the capillary limit); the CSF force is
+rebuilt from the current mass every step.
+
+Layouts. Serial (CPU, small scenes): many steps inside one kernel call with the step loop
+serialized, since a kernel launch costs tens of microseconds and the paper's scene has a few
+thousand points. Parallel (GPU, large scenes): one kernel call per step, every stage a parallel
+loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
 """
 
 import taichi as ti
