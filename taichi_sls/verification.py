@@ -484,6 +484,12 @@ def run_laplace(case: Case) -> Result:
         ps.append(np.mean(-0.5 * (sig[inner, 0, 0] + sig[inner, 1, 1])))
         vs.append(np.linalg.norm(st.v.to_numpy(), axis=1).max())
     gamma = m.surface_tension_N_m
+    from .step import surface_only
+
+    surface_only(st)  # the curvature the settled points give, where the CSF force acts
+    k = st.kappa.to_numpy()
+    w = st.gm.to_numpy() * np.linalg.norm(st.gradm.to_numpy(), axis=2)
+    w *= (st.kvalid.to_numpy() & 2) > 0
     errors = {
         "pressure": float(np.mean(ps) / ref.laplace_pressure_2d(gamma, R) - 1.0),
         "capillary_number": _eta_newtonian(m) * max(vs) / gamma,
@@ -494,6 +500,7 @@ def run_laplace(case: Case) -> Result:
         errors,
         t0,
         v_max_m_s=max(vs),
+        force_weighted_curvature_end=float((w * k).sum() / w.sum() * R - 1.0),
         v_over_capillary=max(vs) / math.sqrt(gamma / (m.density_kg_m3 * R)),
     )
 
