@@ -245,7 +245,11 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
         fig.savefig(made[-1], dpi=70)
         plt.close(fig)
 
-    trans = [s for s in cases if s.transfers_at]
+    trans = [
+        s
+        for s in cases
+        if s.transfers_at and len({r["transfer"] for r in rows if r["case"] == s.name}) > 1
+    ]
     if trans:
         fig, axes = plt.subplots(1, len(trans), figsize=(3.4 * len(trans), 3), squeeze=False)
         for ax, s in zip(axes.flat, trans, strict=False):

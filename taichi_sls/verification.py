@@ -318,7 +318,7 @@ def run_perzyna(case: Case) -> Result:
         errors=errors,
         wall_s=time.perf_counter() - t0,
         steps=n + n_load + n_hold,
-        transfer="-",
+        transfer=_transfer_label(case),  # no grid transfer: the label keeps the rows together
         precision=case.solver.precision,
         info={"tau_s": eta / (2 * mu), "overstress_at_hold": float(f[n_load - 1])},
     )
@@ -456,10 +456,13 @@ def _eta_newtonian(m: Material) -> float:
 
 
 def _mode_amplitude(st, n: int) -> float:
-    """eps_n of r = R(1 + eps cos n theta) from the points: sum V r^n cos(n theta) / (pi R^(n+2))
-    about the volume centroid, R^2 = area/pi (first order in eps)."""
-    V = st.vol0.to_numpy() * st.J.to_numpy()
-    x = st.x.to_numpy()
+    return mode_amplitude(st.x.to_numpy(), st.vol0.to_numpy() * st.J.to_numpy(), n)
+
+
+def mode_amplitude(x: np.ndarray, V: np.ndarray, n: int) -> float:
+    """eps_n of r = R(1 + eps cos n theta) from points x (N, 2) of volumes V: the integral of
+    r^n cos(n theta) over the body is pi R^(n+2) eps to first order, taken about the volume
+    centroid with R^2 = area/pi."""
     z = (x[:, 0] + 1j * x[:, 1]) - (V[:, None] * x).sum(axis=0) @ [1, 1j] / V.sum()
     R2 = V.sum() / np.pi
     return float((V * (z**n).real).sum() / (np.pi * R2 ** (n / 2 + 1)))
