@@ -212,7 +212,7 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
         pts = _series(rows, s.name, s.measure, _default_transfer(rows, s.name), "f64")
         t = [float(r["wall_s"]) for r in pts]
         e = [max(abs(float(r["error"])), 1e-16) for r in pts]
-        ax.loglog(t, e, "o-", label=s.name, color=f"C{i % 10}", ls="-" if i < 10 else "--")
+        ax.loglog(t, e, marker="o", label=s.name, color=f"C{i % 10}", ls="-" if i < 10 else "--")
     ax.set_xlabel("wall time (s, compile included)")
     ax.set_ylabel("|error|")
     ax.set_title("Run time against error (each line: refinement of one case)", fontsize=10)

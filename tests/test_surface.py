@@ -9,6 +9,7 @@ from taichi_sls import verification as ver
 from taichi_sls.monitor import column_material_length, contact_line
 from taichi_sls.simulation import Simulation
 
+
 def disc_curvature_error(R: float, h: float, **surface) -> tuple[float, float]:
     """(mean, RMS) relative curvature error over the interface nodes of a disc of points
     (cases/verification/curvature.toml with radius R and spacing h)."""
@@ -67,9 +68,10 @@ def test_square_relaxes_towards_a_disc():
     under surface tension, keeping its area."""
     r = ver.run(ver.load("square", 2.0))
     print("square:", r.errors, r.info)
-    # measured: SQUARE_MEASURED. Tolerance: the n = 4 amplitude falls by more than half in 300 us;
-    # the area (nearly incompressible) within 2 %
-    assert r.errors["mode4_left"] < 0.5
+    # measured: n = 4 amplitude 0.47 of its start after 300 us (0.92 at h = 4 um), area +1.0 %.
+    # Tolerance: the amplitude falls below 0.6 of its start; the area (nearly incompressible)
+    # within 2 %
+    assert r.errors["mode4_left"] < 0.6
     assert r.errors["area"] < 0.02
 
 
