@@ -123,7 +123,7 @@ def run_study(quick: bool, out: Path, only: list[str] | None = None) -> list[dic
                     jobs += [(r, {"solver": t}) for k, t in TRANSFERS.items() if k != own]
                 jobs += [(r, {"solver": {"precision": "f32"}}) for r in s.f32_at]
             for res, extra in jobs:
-                sets = ver._deep_update(s.sets, extra)
+                sets = ver.deep_update(s.sets, extra)
                 try:
                     r = ver.run(ver.load(s.name, res, sets))
                 except Exception as e:  # a failing case is a row, never the end of the study
@@ -174,6 +174,27 @@ def observed_orders(hs: list[float], errs: list[float]) -> list[float]:
 def _default_transfer(rows: list[dict], case: str) -> str:
     """The transfer label of the case file's own solver settings (verification._transfer_label)."""
     return ver._transfer_label(ver.load(case))
+
+
+def _error_line(ax, pts: list[dict], fmt: str, **kw) -> None:
+    h = [float(r["h_um"]) for r in pts]
+    ax.loglog(h, [max(abs(float(r["error"])), 1e-16) for r in pts], fmt, **kw)
+
+
+def _panel_labels(ax, s: Study) -> None:
+    ax.set_title(f"{s.name}: {s.measure}", fontsize=9)
+    ax.set_xlabel("h (um)", fontsize=8)
+    ax.legend(fontsize=7)
+
+
+def _save(fig, title: str, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=70)
+    plt.close(fig)
+    return path
 
 
 def plot(rows: list[dict], out: Path) -> list[Path]:
@@ -230,20 +251,9 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
                 pts = _series(rows, s.name, s.measure, _default_transfer(rows, s.name), p)
                 hs = {float(r["h_um"]) for r in _series(rows, s.name, s.measure, None, "f32")}
                 pts = [r for r in pts if float(r["h_um"]) in hs]
-                ax.loglog(
-                    [float(r["h_um"]) for r in pts],
-                    [max(abs(float(r["error"])), 1e-16) for r in pts],
-                    mk,
-                    label=p,
-                )
-            ax.set_title(f"{s.name}: {s.measure}", fontsize=9)
-            ax.set_xlabel("h (um)", fontsize=8)
-            ax.legend(fontsize=7)
-        fig.suptitle("f64 against f32", fontsize=10)
-        fig.tight_layout()
-        made.append(out / "accuracy_precision.png")
-        fig.savefig(made[-1], dpi=70)
-        plt.close(fig)
+                _error_line(ax, pts, mk, label=p)
+            _panel_labels(ax, s)
+        made.append(_save(fig, "f64 against f32", out / "accuracy_precision.png"))
 
     trans = [
         s
@@ -259,21 +269,11 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
                     for r in _series(rows, s.name, s.measure, t, "f64")
                     if float(r["resolution"]) in s.transfers_at
                 ]
-                ax.loglog(
-                    [float(r["h_um"]) for r in pts],
-                    [max(abs(float(r["error"])), 1e-16) for r in pts],
-                    "o-",
-                    label=t,
-                    color=f"C{i}",
-                )
-            ax.set_title(f"{s.name}: {s.measure}", fontsize=9)
-            ax.set_xlabel("h (um)", fontsize=8)
-            ax.legend(fontsize=7)
-        fig.suptitle("Transfers: APIC, FLIP, PIC/FLIP 0.9", fontsize=10)
-        fig.tight_layout()
-        made.append(out / "accuracy_transfer.png")
-        fig.savefig(made[-1], dpi=70)
-        plt.close(fig)
+                _error_line(ax, pts, "o-", label=t, color=f"C{i}")
+            _panel_labels(ax, s)
+        made.append(
+            _save(fig, "Transfers: APIC, FLIP, PIC/FLIP 0.9", out / "accuracy_transfer.png")
+        )
     return made
 
 

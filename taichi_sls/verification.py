@@ -57,11 +57,12 @@ def case_names() -> list[str]:
     return sorted(p.stem for p in CASES.glob("*.toml"))
 
 
-def _deep_update(base: dict, extra: dict) -> dict:
+def deep_update(base: dict, extra: dict) -> dict:
+    """A copy of ``base`` with the nested dict ``extra`` merged in (lists are replaced)."""
     out = copy.deepcopy(base)
     for k, v in extra.items():
         if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _deep_update(out[k], v)
+            out[k] = deep_update(out[k], v)
         else:
             out[k] = copy.deepcopy(v)
     return out
@@ -121,7 +122,7 @@ def load(name: str, resolution: float | None = None, sets: dict | None = None) -
         raise CaseError(
             f"verification case {name!r} does not exist; available: {', '.join(case_names())}"
         )
-    data = _deep_update(read_toml(path, "verification case"), sets or {})
+    data = deep_update(read_toml(path, "verification case"), sets or {})
     data.setdefault("case", {}).setdefault("name", name)
     data.setdefault("grid", {})
     kind = data.get("verification", {}).get("kind", "none")
