@@ -1,23 +1,30 @@
-"""Benchmarks: ``python -m taichi_sls.bench speed`` (cost per step and per point-step) and
-``python -m taichi_sls.bench accuracy`` (verification cases against analytic solutions)."""
+"""Benchmarks: ``python -m taichi_sls.bench SUBCOMMAND ...``.
+
+``speed``: cost per step and per point-step against the one-kernel-per-stage layout and a minimal
+MLS-MPM step (:mod:`taichi_sls.speed`); ``accuracy``: the verification cases against analytic
+solutions at several resolutions (:mod:`taichi_sls.accuracy`)."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    commands = ("speed", "accuracy")
-    if not argv or argv[0] not in commands:
-        print(f"usage: python -m taichi_sls.bench {{{','.join(commands)}}} [options]; -h for help")
-        return 2
-    if argv[0] == "speed":
-        from .speed import main as run
-    else:
-        from .accuracy import main as run
-    return run(argv[1:])
+    if argv[:1] == ["speed"]:  # parses its own options
+        from .speed import main as speed
+
+        return speed(argv[1:])
+    from . import accuracy
+
+    ap = argparse.ArgumentParser(prog="python -m taichi_sls.bench", description=__doc__)
+    sub = ap.add_subparsers(dest="command", required=True)
+    accuracy.add_parser(sub)
+    sub.add_parser("speed", help="speed benchmark (python -m taichi_sls.bench speed -h)")
+    args = ap.parse_args(argv)
+    return args.func(args)
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

@@ -80,6 +80,10 @@ class Body:
     max_um: list[float] = _opt(factory=lambda: [10.0, 10.0], doc="rectangle upper-right (um)")
     temperature_C: float | None = _opt(None, doc="initial temperature; default thermal.initial_C")
     velocity_m_s: list[float] = _opt(factory=lambda: [0.0, 0.0], doc="initial velocity (m/s)")
+    perturbation: float = _opt(
+        0.0, doc="disc only: outline r = R (1 + perturbation cos(mode theta)), |value| < 0.5"
+    )
+    mode: int = _opt(2, doc="disc only: shape mode n >= 2 of the perturbation")
 
 
 @dataclass
@@ -318,6 +322,58 @@ class Output:
     )
 
 
+VERIFICATION_KINDS = (
+    "none",
+    "bar",
+    "steffen",
+    "perzyna",
+    "erf",
+    "gaussian",
+    "stefan",
+    "energy",
+    "curvature",
+    "laplace",
+    "square",
+    "viscous_decay",
+    "inviscid",
+)
+
+
+@dataclass
+class Verification:
+    """Verification cases (cases/verification/, :mod:`taichi_sls.verification`): the analytic
+    comparison the case is built for and the initial conditions or loads the ordinary keys cannot
+    express. Only ``bar``, ``steffen`` and ``gaussian`` change the run itself; the other kinds
+    name the measure that ``python -m taichi_sls.bench accuracy`` takes."""
+
+    kind: str = _opt("none", choices=VERIFICATION_KINDS, doc="which comparison; none: a plain case")
+    velocity_amplitude_m_s: float = _opt(
+        0.0,
+        nonneg=True,
+        doc="bar: initial x-velocity v0 sin(pi x / 2L) of body 0 (a rectangle from x = 0, L its "
+        "length), the first axial mode of a bar fixed at x = 0",
+    )
+    displacement_amplitude_um: float = _opt(
+        0.0,
+        nonneg=True,
+        doc="steffen: A of the manufactured displacement u = A sin(2 pi X/L) sin(pi c t/L), "
+        "c = sqrt(E/rho), driven by the body force it implies (references.steffen_body_force)",
+    )
+    center_um: list[float] = _opt(factory=lambda: [0.0, 0.0], doc="gaussian: centre (um)")
+    sigma_um: float = _opt(
+        0.0, nonneg=True, doc="gaussian: initial standard deviation s0 per axis (um)"
+    )
+    rise_C: float = _opt(
+        0.0, doc="gaussian: initial peak rise over thermal.initial_C, rise exp(-r^2 / 2 s0^2)"
+    )
+    shear_rate_1_s: float = _opt(
+        0.0, nonneg=True, doc="perzyna: engineering shear rate of the constant-rate drive (1/s)"
+    )
+    hold_strain: float = _opt(
+        0.0, nonneg=True, doc="perzyna: shear strain eps_xy held fixed for the relaxation check"
+    )
+
+
 @dataclass
 class Case:
     case: CaseInfo = _opt(factory=CaseInfo)
@@ -333,6 +389,7 @@ class Case:
     lasers: list[Laser] = _opt(factory=list)
     surface_tension: SurfaceTension = _opt(factory=SurfaceTension)
     output: Output = _opt(factory=Output)
+    verification: Verification = _opt(factory=Verification)
 
 
 # --------------------------------------------------------------------------- conversion
@@ -522,8 +579,18 @@ def validate(case: Case) -> None:
         if b.shape == "disc":
             _check_pair(f"{key}.center_um", b.center_um)
             (cx, cy), r = b.center_um, b.radius_um
+            r *= 1.0 + abs(b.perturbation)
             lo, hi = (cx - r, cy - r), (cx + r, cy + r)
+            if not abs(b.perturbation) < 0.5:
+                raise CaseError(f"{key}.perturbation = {b.perturbation}: must lie in (-0.5, 0.5)")
+            if b.mode < 2:
+                raise CaseError(f"{key}.mode = {b.mode}: must be an integer >= 2")
         else:
+            if b.perturbation != 0.0:
+                raise CaseError(
+                    f"{key}.perturbation = {b.perturbation}: only a disc takes a perturbation "
+                    f"(shape = {b.shape!r})"
+                )
             _check_pair(f"{key}.min_um", b.min_um)
             _check_pair(f"{key}.max_um", b.max_um)
             lo, hi = tuple(b.min_um), tuple(b.max_um)
@@ -551,11 +618,44 @@ def validate(case: Case) -> None:
     for i, las in enumerate(case.lasers):
         if las.off_s < las.on_s:
             raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+    _validate_verification(case)
     if case.surface_tension.point_radius_over_h <= math.sqrt(2) / 4:
         raise CaseError(
             f"surface_tension.point_radius_over_h = {case.surface_tension.point_radius_over_h}: "
             f"must exceed sqrt(2)/4 = {math.sqrt(2) / 4:.4f} (interior nodes would read outside)"
         )
+
+
+def _validate_verification(case: Case) -> None:
+    v = case.verification
+    _check_pair("verification.center_um", v.center_um)
+
+    def need(key: str, value: float, why: str) -> None:
+        if not value > 0:
+            raise CaseError(
+                f"verification.{key} = {value}: must be > 0 for kind = {v.kind!r} ({why})"
+            )
+
+    if v.kind in ("bar", "steffen"):
+        b = case.bodies[0]
+        if b.shape != "rect" or b.min_um[0] != 0.0:
+            raise CaseError(
+                f"verification.kind = {v.kind!r}: bodies[0] must be a rectangle starting at "
+                f"x = 0 (the fixed end), got shape = {b.shape!r}, min_um = {b.min_um}"
+            )
+        if not case.physics.mechanics:
+            raise CaseError(f"verification.kind = {v.kind!r}: needs physics.mechanics = true")
+        if v.kind == "bar":
+            need("velocity_amplitude_m_s", v.velocity_amplitude_m_s, "the initial velocity")
+        else:
+            need("displacement_amplitude_um", v.displacement_amplitude_um, "the manufactured field")
+    elif v.kind == "gaussian":
+        need("sigma_um", v.sigma_um, "the initial width")
+        if not case.physics.thermal:
+            raise CaseError("verification.kind = 'gaussian': needs physics.thermal = true")
+    elif v.kind == "perzyna":
+        need("shear_rate_1_s", v.shear_rate_1_s, "the constant-rate drive")
+        need("hold_strain", v.hold_strain, "the relaxation check")
 
 
 def case_to_dict(case: Case) -> dict:
@@ -627,6 +727,7 @@ def describe_keys() -> str:
         ("[[lasers]]", Laser),
         ("surface_tension", SurfaceTension),
         ("output", Output),
+        ("verification", Verification),
     ]
     for title, cls in sections:
         out += [f"## `{title}`", ""]

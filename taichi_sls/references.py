@@ -7,7 +7,8 @@ erf/erfc come from :mod:`math`, root finding is a plain bisection.
 
 Contents
 --------
-1. Fixed-free elastic bar, first axial mode (MPM vibrating-bar benchmark).
+1. Fixed-free elastic bar, first axial mode (MPM vibrating-bar benchmark); a manufactured
+   large-deformation solution of a fixed-fixed bar (Steffen, Kirby & Berzins 2008).
 2. Heat conduction: erf half-space, spreading 2D Gaussian.
 3. Perzyna overstress viscoplasticity (the solver's backward-Euler return map): stress relaxation
    at fixed strain, constant-rate pure shear (continuous closed form and step-by-step discrete).
@@ -107,6 +108,57 @@ def bar_com_velocity(t: ArrayLike, L: float, E: float, rho: float, v0: float) ->
     """
     t = np.asarray(t, dtype=float)
     return _out(2.0 * v0 / np.pi * np.cos(bar_omega(L, E, rho) * t))
+
+
+def steffen_displacement(
+    X: ArrayLike, t: ArrayLike, L: float, A: float, E: float, rho: float
+) -> float | np.ndarray:
+    """Manufactured displacement of a bar fixed at X = 0 and X = L (reference position X):
+
+    u(X,t) = A sin(2 pi X/L) sin(pi c t/L), c = sqrt(E/rho).
+    The form of Steffen, Kirby & Berzins 2008 (IJNME 76, sec. 6, the 1D manufactured solution
+    u = A sin(2 pi X) sin(c pi t) on the unit bar), scaled to a bar of length L; its time
+    frequency is not an eigenfrequency, so the body force of :func:`steffen_body_force` drives it.
+    (The printed eqs. 47-49 could not be retrieved here; the body force below is derived for this
+    solver's own constitutive law instead of theirs.)
+    """
+    X = np.asarray(X, dtype=float)
+    t = np.asarray(t, dtype=float)
+    c = math.sqrt(E / rho)
+    return _out(A * np.sin(2.0 * np.pi * X / L) * np.sin(np.pi * c * t / L))
+
+
+def steffen_velocity(
+    X: ArrayLike, t: ArrayLike, L: float, A: float, E: float, rho: float
+) -> float | np.ndarray:
+    """du/dt of :func:`steffen_displacement`: A w sin(2 pi X/L) cos(w t), w = pi c/L."""
+    X = np.asarray(X, dtype=float)
+    t = np.asarray(t, dtype=float)
+    w = math.pi * math.sqrt(E / rho) / L
+    return _out(A * w * np.sin(2.0 * np.pi * X / L) * np.cos(w * t))
+
+
+def steffen_body_force(
+    X: ArrayLike, t: ArrayLike, L: float, A: float, E: float, rho: float
+) -> float | np.ndarray:
+    """Body force per unit mass (m/s^2) that makes :func:`steffen_displacement` exact.
+
+    Derived for the solver's law in 1D (Poisson ratio 0, plane strain): the strain is accumulated
+    as d(eps)/dt = sym(L) = (dF/dt)/F, so eps = ln F, F = 1 + du/dX, and the axial Cauchy stress
+    sigma = E ln F equals the first Piola-Kirchhoff stress (J = F). Momentum in the reference
+    configuration, rho du^2/dt^2 = dP/dX + rho b, with dP/dX = E u_XX / F and u_XX = -k^2 u,
+    k = 2 pi/L, gives
+    b = u (c^2 k^2 / F - w^2), c^2 = E/rho, w = pi c/L.
+    Source: method of manufactured solutions for MPM, Steffen, Kirby & Berzins 2008 (IJNME 76).
+    """
+    X = np.asarray(X, dtype=float)
+    t = np.asarray(t, dtype=float)
+    c2 = E / rho
+    k = 2.0 * np.pi / L
+    w = math.pi * math.sqrt(c2) / L
+    u = A * np.sin(k * X) * np.sin(w * t)
+    F = 1.0 + A * k * np.cos(k * X) * np.sin(w * t)
+    return _out(u * (c2 * k * k / F - w * w))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -466,8 +518,30 @@ def viscous_decay_rate(n: int, gamma: float, eta_N: float, R: float) -> float:
     cos n theta, with zero shear stress and sigma_rr = -gamma eps (n^2-1)/R cos n theta at
     r = R, and the kinematic condition R d eps/dt = u_r(R) (the usual 2D capillary-viscous drop
     relaxation, cf. Hopper 1990, J. Fluid Mech. 213, plane Stokes flow driven by capillarity).
+    Checked by hand (accuracy issue): sigma_rtheta(R) = 0 gives B R^2 = -(n-1) A/(n+1); then
+    sigma_rr(R) = 4 eta_N (n-1) A R^(n-2) cos n theta, u_r(R) = 2n A R^(n-1)/(n+1) cos n theta,
+    and the normal balance gives d eps/dt = -n gamma eps/(2 eta_N R): the coefficient stands
+    (n = 2: rate = gamma/(eta_N R)).
+
+    eta_N is the Newtonian shear viscosity (deviatoric stress 2 eta_N D). The solver's Perzyna
+    model with zero yield stress and no hardening is a Maxwell fluid, ds/dt = 2 mu D - s/tau,
+    tau = eta/(2 mu) (eq. 41 in the limit of small steps): its steady stress is s = eta D, so
+    eta_N = eta/2, half the paper's eta. It is Newtonian only for rate tau << 1; a Maxwell fluid
+    in the Stokes limit decays at rate/(1 + rate tau) (:func:`maxwell_decay_rate`).
     """
     return n * gamma / (2.0 * eta_N * R)
+
+
+def maxwell_decay_rate(newtonian_rate: float, tau: float) -> float:
+    """Decay rate of a capillary shape mode of a Maxwell fluid (relaxation time tau) in the Stokes
+    limit: s = lam/(1 + lam tau), lam the Newtonian rate of :func:`viscous_decay_rate`.
+
+    The Maxwell fluid's viscosity in the Laplace domain is eta_N/(1 + s tau); putting it into
+    s = -n gamma/(2 eta_N(s) R) gives s (1 + lam tau) = -lam. Source: correspondence principle of
+    linear viscoelasticity (Christensen 1982, Theory of Viscoelasticity, ch. 2) applied to
+    :func:`viscous_decay_rate`.
+    """
+    return newtonian_rate / (1.0 + newtonian_rate * tau)
 
 
 def inviscid_drop_omega(n: int, gamma: float, rho: float, R: float) -> float:

@@ -42,9 +42,39 @@ class Scene:
 def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
     if body.shape == "disc":
         cx, cy = body.center_um
-        return (px - cx) ** 2 + (py - cy) ** 2 < body.radius_um**2
+        dx, dy = px - cx, py - cy
+        # r < R (1 + eps cos n theta): a shape mode of the disc (eps = 0: the plain disc)
+        r = body.radius_um * (1.0 + body.perturbation * np.cos(body.mode * np.arctan2(dy, dx)))
+        return dx**2 + dy**2 < r**2
     (x0, y0), (x1, y1) = body.min_um, body.max_um
     return (px > x0) & (px < x1) & (py > y0) & (py < y1)
+
+
+def _verification_initial(
+    case: Case, x: np.ndarray, body: np.ndarray, T0_C: np.ndarray, v0: np.ndarray
+) -> None:
+    """Initial fields of the verification kinds (case.Verification), in place: the bar's first
+    axial mode, the manufactured solution's initial velocity, the Gaussian temperature."""
+    from . import references as ref
+
+    v = case.verification
+    if v.kind in ("bar", "steffen"):
+        b0 = case.bodies[0]
+        m = case.materials[b0.material]
+        L = b0.max_um[0] * 1e-6
+        sel = body == 0
+        if v.kind == "bar":
+            v0[sel, 0] = ref.bar_velocity(
+                x[sel, 0], 0.0, L, m.youngs_solid_Pa, m.density_kg_m3, v.velocity_amplitude_m_s
+            )
+        else:
+            A = v.displacement_amplitude_um * 1e-6
+            v0[sel, 0] = ref.steffen_velocity(
+                x[sel, 0], 0.0, L, A, m.youngs_solid_Pa, m.density_kg_m3
+            )
+    elif v.kind == "gaussian":
+        r2 = ((x * 1e6 - np.asarray(v.center_um)) ** 2).sum(axis=1)
+        T0_C += v.rise_C * np.exp(-r2 / (2.0 * v.sigma_um**2))
 
 
 def build_scene(case: Case) -> Scene:
@@ -79,6 +109,8 @@ def build_scene(case: Case) -> Scene:
         temps.append(np.full(k, T))
         vels.append(np.tile(np.asarray(b.velocity_m_s, dtype=float), (k, 1)))
     x = np.concatenate(xs) * 1e-6
+    T0_C, v0 = np.concatenate(temps), np.concatenate(vels)
+    _verification_initial(case, x, np.concatenate(bodies), T0_C, v0)
     g = case.grid.ghost_cells
     off = g + PAD
     h = h_um * 1e-6
@@ -93,8 +125,8 @@ def build_scene(case: Case) -> Scene:
         vol=np.full(len(x), (h / n) ** 2),
         body=np.concatenate(bodies),
         material=np.concatenate(mats),
-        T0_C=np.concatenate(temps),
-        v0=np.concatenate(vels),
+        T0_C=T0_C,
+        v0=v0,
         material_names=names,
         table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g),
     )

@@ -141,9 +141,31 @@ class Simulation:
 
     def advance(self, n: int) -> None:
         """Advance n steps."""
-        if n > 0:
+        if n <= 0:
+            return
+        if self.case.verification.kind == "steffen":
+            for _ in range(n):  # the manufactured body force changes every step
+                self._manufactured_impulse()
+                advance(self.state, 1)
+        else:
             advance(self.state, n)
-            self.steps += n
+        self.steps += n
+
+    def _manufactured_impulse(self) -> None:
+        """v += b(X, t) dt on body 0: the body force of references.steffen_body_force at the
+        start of the step (the explicit step takes its forces at t_n, eq. 13)."""
+        from .references import steffen_body_force
+
+        c = self.case
+        b0 = c.bodies[0]
+        m = c.materials[b0.material]
+        sel = self.scene.body == 0
+        X = self.state.x0.to_numpy()[sel, 0]
+        v = self.state.v.to_numpy()
+        L, A = b0.max_um[0] * 1e-6, c.verification.displacement_amplitude_um * 1e-6
+        b = steffen_body_force(X, self.t, L, A, m.youngs_solid_Pa, m.density_kg_m3)
+        v[sel, 0] += b * self.dt
+        self.state.v.from_numpy(v)
 
     # ------------------------------------------------------------------ monitors
     def phi(self) -> np.ndarray:

@@ -6,6 +6,7 @@ import copy
 import pytest
 
 from taichi_sls.case import case_from_dict
+from taichi_sls.verification import deep_update
 
 PAPER_SCENE = {
     "domain": {"width_um": 80.0, "height_um": 48.0},
@@ -14,16 +15,6 @@ PAPER_SCENE = {
         {"shape": "disc", "center_um": [60.0, 20.0], "radius_um": 20.0},
     ],
 }
-
-
-def deep_update(base: dict, extra: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in extra.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = deep_update(out[k], v)
-        else:
-            out[k] = copy.deepcopy(v)
-    return out
 
 
 def make_case(data: dict):

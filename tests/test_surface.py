@@ -5,37 +5,18 @@ import numpy as np
 import pytest
 from conftest import PAPER_SCENE, deep_update, make_case
 
+from taichi_sls import verification as ver
 from taichi_sls.monitor import column_material_length, contact_line
 from taichi_sls.simulation import Simulation
-from taichi_sls.step import surface_only
-
-OPEN = {
-    w: {"mechanical": "open", "thermal": "insulated"} for w in ("left", "right", "bottom", "top")
-}
-
-
-def _disc_case(R: float, h: float, surface: dict | None = None, **extra) -> dict:
-    W = 2 * R + 12 * h
-    # centre off the grid lines so that the seeding is not symmetric about a node
-    data = {
-        "grid": {"spacing_um": h},
-        "domain": {"width_um": W, "height_um": W},
-        "bodies": [{"center_um": [W / 2 + 0.123 * h, W / 2 + 0.377 * h], "radius_um": R}],
-        "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0]},
-        "surface_tension": surface or {},
-        "boundary": OPEN,
-    }
-    return deep_update(data, extra)
 
 
 def disc_curvature_error(R: float, h: float, **surface) -> tuple[float, float]:
-    """(mean, RMS) relative curvature error over the interface nodes of a disc of points."""
-    sim = Simulation(make_case(_disc_case(R, h, surface)))
-    surface_only(sim.state)
-    k = sim.state.kappa.to_numpy()
-    iface = (sim.state.kvalid.to_numpy() & 2) > 0
-    rel = k[iface] * R * 1e-6 - 1.0
-    return float(rel.mean()), float(np.sqrt(np.mean(rel**2)))
+    """(mean, RMS) relative curvature error over the interface nodes of a disc of points
+    (cases/verification/curvature.toml with radius R and spacing h)."""
+    body = {"shape": "disc", "radius_um": R, "center_um": [0.0, 0.0]}  # centred by the loader
+    sets = {"bodies": [body], "surface_tension": surface}
+    e = ver.run(ver.load("curvature", R / h, sets)).errors
+    return e["curvature_mean"], e["curvature_rms"]
 
 
 @pytest.mark.parametrize(
@@ -69,86 +50,29 @@ def test_unsmoothed_level_set_is_not_usable():
 
 
 def test_laplace_pressure_of_a_static_disc():
-    """A stiff elastic disc under surface tension settles to a uniform mean in-plane pressure
-    gamma / R (2D Laplace law); the spurious velocities that remain are reported and bounded."""
-    R, h, gamma, rho = 20.0, 2.0, 36.3e-3, 1020.0
-    case = make_case(
-        _disc_case(
-            R,
-            h,
-            # PIC damps the start-up waves so that the static state can be read
-            solver={"transfer": "pic_flip", "flip_ratio": 0.0},
-            physics={"plasticity": False},
-            materials={"PA12": {"youngs_solid_Pa": 1e6, "youngs_liquid_Pa": 1e6}},
-        )
-    )
-    sim = Simulation(case)
-    st = sim.state
-    sim.advance(int(round(60e-6 / sim.dt)))  # the breathing mode has decayed by then
-    ps, vs = [], []
-    for _ in range(8):  # average the residual oscillation over 40 us
-        sim.advance(int(round(5e-6 / sim.dt)))
-        x = st.x.to_numpy()
-        inner = np.linalg.norm(x - x.mean(axis=0), axis=1) < 0.5 * R * 1e-6
-        sig = st.sigma.to_numpy()
-        ps.append(np.mean(-0.5 * (sig[inner, 0, 0] + sig[inner, 1, 1])))
-        vs.append(np.linalg.norm(st.v.to_numpy(), axis=1).max())
-    err = np.mean(ps) / (gamma / (R * 1e-6)) - 1.0
-    # spurious velocity against the capillary-inertial velocity sqrt(gamma / (rho R))
-    we = max(vs) / np.sqrt(gamma / (rho * R * 1e-6))
-    print(
-        f"Laplace pressure error {err:+.4f} (R/h = 10), spurious |v|max {max(vs):.2e} m/s "
-        f"= {we:.1e} of the capillary velocity"
-    )
-    # measured: +0.3 %, |v|max 1.7e-3 m/s (1.2e-3 of the capillary velocity). Tolerances: 2 %
-    # on the pressure; spurious velocities under 1 % of the capillary velocity
-    assert abs(err) < 0.02
-    assert we < 1e-2
+    """A disc of Maxwell fluid at rest under surface tension carries the mean in-plane pressure
+    gamma / R (2D Laplace law; cases/verification/laplace.toml at R/h = 10); the spurious
+    velocities that remain are reported and bounded."""
+    r = ver.run(ver.load("laplace", 10))
+    print("Laplace, R/h = 10:", r.errors, r.info)
+    # measured: pressure -1.1 %, |v|max 4.5e-3 m/s = 3.4e-3 of the capillary velocity
+    # sqrt(gamma / rho R), capillary number eta_N |v| / gamma = 0.037 (the issue's 1e-3 is
+    # missed; docs/accuracy_section.md). Tolerances: 2 % on the pressure; spurious velocities
+    # under 1 % of the capillary velocity
+    assert abs(r.errors["pressure"]) < 0.02
+    assert r.info["v_over_capillary"] < 1e-2
 
 
 def test_square_relaxes_towards_a_disc():
-    """A square of a soft, low-viscosity Perzyna fluid (zero yield) rounds off under surface
-    tension, keeping its area."""
-    h = 2.0
-    case = make_case(
-        {
-            "grid": {"spacing_um": h},
-            "domain": {"width_um": 48.0, "height_um": 48.0},
-            "bodies": [{"shape": "rect", "min_um": [14.0, 14.0], "max_um": [34.0, 34.0]}],
-            "materials": {
-                # nearly incompressible Maxwell fluid: visco-capillary time eta R / gamma = 28 us
-                "PA12": {
-                    "youngs_solid_Pa": 1e5,
-                    "poisson": 0.45,
-                    "yield_solid_Pa": 0.0,
-                    "yield_liquid_Pa": 0.0,
-                    "hardening_solid_Pa": 0.0,
-                    "viscosity_model": "constant",
-                    "viscosity_Pas": 0.1,
-                }
-            },
-            "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0]},
-            "boundary": OPEN,
-            "solver": {"transfer": "pic_flip", "flip_ratio": 0.5},
-        }
-    )
-    sim = Simulation(case)
-    st = sim.state
-
-    def corner_excess() -> float:
-        x = st.x.to_numpy()
-        r = np.linalg.norm(x - x.mean(axis=0), axis=1)
-        area = (st.vol0.to_numpy() * st.J.to_numpy()).sum()
-        return r.max() / np.sqrt(area / np.pi), area
-
-    e0, a0 = corner_excess()
-    sim.advance(int(round(300e-6 / sim.dt)))
-    e1, a1 = corner_excess()
-    print(f"max radius / disc radius: {e0:.3f} -> {e1:.3f}; area change {a1 / a0 - 1:+.4f}")
-    # measured: 1.191 -> 1.082 in 300 us, area -1.0 %. Tolerance: the corners pull in more than
-    # half the way to the disc; the area (nearly incompressible) within 2 %
-    assert e1 - 1.0 < 0.5 * (e0 - 1.0)
-    assert abs(a1 / a0 - 1.0) < 0.02
+    """A square of soft, low-viscosity Maxwell fluid (cases/verification/square.toml) rounds off
+    under surface tension, keeping its area."""
+    r = ver.run(ver.load("square", 2.0))
+    print("square:", r.errors, r.info)
+    # measured: n = 4 amplitude 0.47 of its start after 300 us (0.92 at h = 4 um), area +1.0 %.
+    # Tolerance: the amplitude falls below 0.6 of its start; the area (nearly incompressible)
+    # within 2 %
+    assert r.errors["mode4_left"] < 0.6
+    assert r.errors["area"] < 0.02
 
 
 def test_contact_line_on_constructed_shapes():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import PAPER_SCENE, deep_update, make_case
 
-from taichi_sls import references as ref
+from taichi_sls import verification as ver
 from taichi_sls.simulation import Simulation
 
 RHO, K, C = 1020.0, 0.28, 2700.0
@@ -14,43 +14,9 @@ ALPHA = K / (RHO * C)
 INSULATED = {w: {"thermal": "insulated"} for w in ("left", "right", "bottom", "top")}
 
 
-def _slab(h: float, T0: float, Ts: float, material: dict, length: float = 80.0):
-    """A frozen 1D slab along x, the left wall held at Ts, every other wall insulated."""
-    return make_case(
-        {
-            "grid": {"spacing_um": h},
-            "domain": {"width_um": length, "height_um": 4 * h},
-            "bodies": [{"shape": "rect", "min_um": [0.0, 0.0], "max_um": [length, 2 * h]}],
-            "materials": {"PA12": material},
-            "physics": {"mechanics": False, "surface_tension": False},
-            "boundary": deep_update(INSULATED, {"left": {"thermal": "fixed", "temperature_C": Ts}}),
-            "thermal": {"initial_C": T0},
-            "time": {"safety": 0.2},
-        }
-    )
-
-
-def _run_to(sim: Simulation, t_end: float) -> None:
-    sim.advance(int(round(t_end / sim.dt)))
-
-
 def test_conduction_erf_second_order():
-    """Semi-infinite slab with a fixed-temperature face against the erf solution."""
-    mat = {
-        "latent_heat_J_kg": 0.0,
-        "melt_C": 1000.0,
-        "crystallization_C": 900.0,
-        "conductivity_liquid_W_mK": K,
-    }
-    t_end = 5e-4
-    errs = []
-    for h in (4.0, 2.0, 1.0):
-        sim = Simulation(_slab(h, 100.0, 200.0, mat))
-        _run_to(sim, t_end)
-        x = sim.state.x.to_numpy()[:, 0]
-        T = sim.state.T.to_numpy() - 273.15
-        exact = ref.erf_slab(x, sim.t, 100.0, 200.0, ALPHA)
-        errs.append(np.sqrt(np.mean((T - exact) ** 2)) / 100.0)
+    """Semi-infinite slab with a fixed-temperature face (cases/verification/erf.toml)."""
+    errs = [ver.run(ver.load("erf", h)).errors["temperature_rms"] for h in (4.0, 2.0, 1.0)]
     orders = [math.log2(errs[i] / errs[i + 1]) for i in range(2)]
     print("erf conduction RMS errors:", errs, "orders:", orders)
     # measured: RMS 7.2e-3, 1.2e-3, 2.8e-4 of the jump (orders 2.6, 2.1). Tolerance: second
@@ -75,13 +41,11 @@ def _laser_case(fixed_bottom: bool):
 
 
 def test_energy_balance_insulated_to_round_off():
-    sim = Simulation(_laser_case(False))
-    H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(400)
-    m = sim.monitors()
-    rise = m["enthalpy_J_per_m"] - H0
-    assert m["laser_energy_J_per_m"] > 0 and m["heat_out_J_per_m"] == 0.0
-    assert abs(rise - m["laser_energy_J_per_m"]) / m["laser_energy_J_per_m"] < 1e-9
+    """cases/verification/energy.toml: laser energy against enthalpy rise, insulated body."""
+    r = ver.run(ver.load("energy"))
+    assert r.info["heat_out_fraction"] == 0.0
+    # measured 1.2e-14 over 989 steps; the issue's target 1e-9
+    assert r.errors["energy_balance"] < 1e-9
 
 
 def test_energy_balance_with_fixed_baseplate():
@@ -98,30 +62,14 @@ def test_energy_balance_with_fixed_baseplate():
 
 
 def test_melting_with_mushy_zone_against_similarity_solution():
-    """1D melting from a hot face: three-zone similarity solution with the linear mushy zone."""
-    mat = {"conductivity_liquid_W_mK": K, "conductivity_solid_W_mK": K}
-    T0, Ts, Tc, Tm, L = 120.0, 250.0, 146.0, 175.0, 50e3
-    t_end = 5e-4
-    errs, fronts = [], []
-    for h in (2.0, 1.0):
-        sim = Simulation(_slab(h, T0, Ts, mat))
-        _run_to(sim, t_end)
-        x = sim.state.x.to_numpy()[:, 0]
-        T = sim.state.T.to_numpy() - 273.15
-        exact = ref.mushy_stefan(x, sim.t, T0, Ts, Tc, Tm, K, RHO, C, L)
-        errs.append(np.sqrt(np.mean((T - exact) ** 2)) / (Ts - T0))
-        # melt front: where the point temperatures cross T_m (points on one row, sorted)
-        row = np.argsort(x)
-        xs, Ts_ = x[row][::2], T[row][::2]
-        k = np.argmax(Ts_ < Tm)
-        xf = xs[k - 1] + (Tm - Ts_[k - 1]) * (xs[k] - xs[k - 1]) / (Ts_[k] - Ts_[k - 1])
-        Xm, _ = ref.mushy_stefan_fronts(sim.t, T0, Ts, Tc, Tm, K, RHO, C, L)
-        fronts.append(abs(xf - Xm) / Xm)
-    print("mushy Stefan RMS errors:", errs, "front errors:", fronts)
-    # measured: RMS 2.2e-3, 7.5e-4 of the jump; front 1.0 %, 1.0 % (h = 2, 1 um). Tolerance:
-    # RMS under 0.2 % of the jump and improving; front within 2 % at h = 1 um
-    assert errs[-1] < 2e-3 and errs[-1] < errs[0]
-    assert fronts[-1] < 0.02
+    """1D melting from a hot face: three-zone similarity solution with the linear mushy zone
+    (cases/verification/stefan.toml at 25 cells across the melt depth)."""
+    r = ver.run(ver.load("stefan", 25))
+    print("mushy Stefan at 25 cells across X_m:", r.errors)
+    # measured: temperature RMS 2.9e-4 and max 2.3e-3 of the jump, melt front 0.49 %. Tolerance:
+    # the issue's 1 % on front and temperature (asked at 100 cells, met at 25 already)
+    assert r.errors["melt_front"] < 0.01
+    assert r.errors["temperature_max"] < 0.01
 
 
 def test_free_thermal_expansion_is_stress_free():
