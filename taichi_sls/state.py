@@ -138,6 +138,8 @@ class State:
         self.kappa = ti.field(float, gs)
         self.ktmp = ti.field(float, gs)
         self.kvalid = ti.field(ti.i32, gs)
+        self.iface = ti.Vector.field(2, ti.i32, scene.nx * scene.ny)  # interface nodes
+        self.n_iface = ti.field(ti.i32, ())
         self.gradm = ti.Vector.field(dim, float, gs)
         self.seg = ti.Vector.field(8, float, (scene.nx - 1, scene.ny - 1))  # <= 2 segments/cell
         self.nseg = ti.field(ti.i32, (scene.nx - 1, scene.ny - 1))
