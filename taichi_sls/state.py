@@ -20,11 +20,11 @@ LASER_PARAMS = ("on", "off", "x0", "speed", "x_end", "top", "amp", "r0", "eta", 
 LP = {n: i for i, n in enumerate(LASER_PARAMS)}
 
 
-def parallel_layout(case: Case, n_points: int) -> bool:
+def parallel_layout(case: Case) -> bool:
     """One parallel kernel call per step (True) or many serialized steps per call (False)."""
     lay = case.solver.layout
     if lay == "auto":
-        return case.solver.arch == "gpu" or n_points >= case.solver.parallel_points
+        return case.solver.arch == "gpu"
     return lay == "parallel"
 
 
@@ -54,7 +54,7 @@ class State:
         self.ncx = int(round(scene.width / scene.h))
         self.ncy = int(round(scene.height / scene.h))
 
-        self.parallel = parallel_layout(case, n)
+        self.parallel = parallel_layout(case)
         ph = case.physics
         self.mech = ph.mechanics
         self.thermal = ph.thermal
