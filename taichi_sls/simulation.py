@@ -110,14 +110,16 @@ def resolve_curvature_every(case: Case, dt: float, limits: dict[str, float]) -> 
 
 
 class Simulation:
-    def __init__(self, case: Case, *, init: bool = True) -> None:
+    def __init__(self, case: Case, *, init: bool = True, scene: Scene | None = None) -> None:
+        """``scene``: the points to use instead of seeding the case's bodies (the speed
+        benchmark passes them shuffled)."""
         if init:
             init_taichi(case.solver.arch, case.solver.precision, case.solver.optimize)
         self.case = case
         self.dt, self.dt_limits = resolve_dt(case)
         self.heat_every = resolve_heat_every(case, self.dt, self.dt_limits)
         self.curvature_every = resolve_curvature_every(case, self.dt, self.dt_limits)
-        self.scene: Scene = build_scene(case)
+        self.scene: Scene = build_scene(case) if scene is None else scene
         self.state = State(case, self.scene, self.heat_every, self.curvature_every)
         self.state.dt[None] = self.dt
         # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32

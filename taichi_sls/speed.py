@@ -14,7 +14,6 @@ import dataclasses
 import json
 import math
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,12 +22,7 @@ import taichi as ti
 from .case import Case, apply_override, case_from_dict, load_case
 from .floor import MinimalMPM
 from .scene import build_scene
-from .simulation import (
-    init_taichi,
-    resolve_curvature_every,
-    resolve_dt,
-    resolve_heat_every,
-)
+from .simulation import Simulation
 from .state import State
 from .step import advance, advance_staged
 
@@ -78,29 +72,14 @@ def layer_case(n_target: int) -> dict:
     }
 
 
-@dataclass
-class Setup:
-    case: Case
-    state: State
-    compile_s: float
-
-
-def build(case: Case, shuffle: bool = False) -> Setup:
-    """A State of the case (Taichi re-initialised), its step kernel compiled."""
-    init_taichi(case.solver.arch, case.solver.precision, case.solver.optimize)
-    dt, limits = resolve_dt(case)
+def build(case: Case, shuffle: bool = False) -> Simulation:
+    """A Simulation of the case (Taichi re-initialised), its step kernel compiled."""
     scene = build_scene(case)
     if shuffle:  # points in random order: what sorting by cell is worth
         order = np.random.default_rng(0).permutation(scene.n_points)
         for k in ("x", "vol", "body", "material", "T0_C", "v0"):
             setattr(scene, k, getattr(scene, k)[order])
-    st = State(
-        case, scene, resolve_heat_every(case, dt, limits), resolve_curvature_every(case, dt, limits)
-    )
-    st.dt[None] = dt
-    t0 = time.perf_counter()
-    advance(st, 0)
-    return Setup(case, st, time.perf_counter() - t0)
+    return Simulation(case, scene=scene)
 
 
 def field_bytes(obj: object) -> int:
@@ -150,7 +129,7 @@ def _row(label: str, st: State, variant: str, t: float, steps: int, **extra) -> 
     } | extra
 
 
-def _time_state(s: Setup, seconds: float, staged: bool = False) -> tuple[float, int]:
+def _time_state(s: Simulation, seconds: float, staged: bool = False) -> tuple[float, int]:
     st = s.state
     # one full cycle of the heat and curvature clocks compiles every variant of a layout
     cycle = st.heat_every * st.geom_every + 1
@@ -180,10 +159,14 @@ def measure_scene(label: str, case: Case, seconds: float, compare: bool) -> list
         return rows
     x, nx, ny, h, dt = st.x.to_numpy(), st.nx, st.ny, st.h, float(st.dt[None])
     other = "serial" if st.parallel else "parallel"
-    so = build(_with(case, f"solver.layout={other}"))
+    so = build(_case_from(dataclasses.asdict(case), [f"solver.layout={other}"]))
     t_o, k = _time_state(so, seconds)
     rows.append(_row(label, so.state, f"full physics, {other} layout", t_o, k, ratio=t_o / t_full))
-    sp = so if other == "parallel" else build(_with(case, "solver.layout=parallel"))
+    sp = (
+        so
+        if other == "parallel"
+        else build(_case_from(dataclasses.asdict(case), ["solver.layout=parallel"]))
+    )
     t_s, k = _time_state(sp, seconds, staged=True)
     rows.append(_row(label, sp.state, "one kernel call per stage", t_s, k, ratio=t_s / t_full))
     for lay in ("serial", "parallel"):
@@ -207,12 +190,6 @@ def measure_scene(label: str, case: Case, seconds: float, compare: bool) -> list
             )
         )
     return rows
-
-
-def _with(case: Case, override: str) -> Case:
-    data = dataclasses.asdict(case)
-    apply_override(data, override)
-    return case_from_dict(data)
 
 
 def measure_sorting(case: Case, seconds: float) -> list[dict]:
