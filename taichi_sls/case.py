@@ -104,7 +104,15 @@ class Material:
     solidification_dilatation: float = _opt(
         0.015, doc="beta: d(eps_m) = beta d(xi_s) 1 (eq. 37); 0.015 = the paper's 1.5 %"
     )
-    poisson: float = _opt(0.42, doc="nu, in (-1, 0.5)")
+    poisson: float = _opt(0.42, doc="nu for T <= T_c, in (-1, 0.5) (Table 3)")
+    poisson_liquid: float = _opt(
+        0.49,
+        doc="nu for T >= T_m, in (-1, 0.5); interpolated in xi_s like E. Default 0.49: a melt is "
+        "nearly incompressible; the paper's one nu (set 0.42 for its reading) makes the 10 kPa "
+        "melt's bulk modulus 21 kPa, which its own Laplace pressure compresses by 8 % in area "
+        "and so opens the neck (README). 0.49 keeps the melt's P-wave modulus below the solid's: "
+        "the same time step",
+    )
     youngs_solid_Pa: float = _opt(1e5, positive=True, doc="E for T <= T_c")
     youngs_liquid_Pa: float = _opt(1e4, positive=True, doc="E for T >= T_m")
     yield_solid_Pa: float = _opt(1e5, nonneg=True, doc="sigma_Y for T <= T_c")
@@ -300,6 +308,14 @@ class SurfaceTension:
         positive=True,
         maximum=1.0,
         doc='curvature age as a fraction of the capillary limit for curvature_every = "auto"',
+    )
+    initial_stress: str = _opt(
+        "laplace",
+        choices=("laplace", "none"),
+        doc="laplace: every disc starts in equilibrium with its own surface tension (in-plane "
+        "pressure gamma/R, carried by the elastic strain at its initial temperature; other "
+        "shapes start stress-free); none: every body starts stress-free and its Laplace "
+        "pressure compresses it once the run starts (the paper does not say)",
     )
 
 
@@ -557,8 +573,10 @@ def validate(case: Case) -> None:
         raise CaseError("bodies: at least one [[bodies]] table is required")
     for name, m in case.materials.items():
         key = f"materials.{name}"
-        if not -1.0 < m.poisson < 0.5:
-            raise CaseError(f"{key}.poisson = {m.poisson}: must lie in (-1, 0.5)")
+        for k in ("poisson", "poisson_liquid"):
+            v = getattr(m, k)
+            if not -1.0 < v < 0.5:
+                raise CaseError(f"{key}.{k} = {v}: must lie in (-1, 0.5)")
         if not m.crystallization_C < m.melt_C:
             raise CaseError(
                 f"{key}.crystallization_C = {m.crystallization_C}: must be below "

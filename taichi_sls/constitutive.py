@@ -10,7 +10,7 @@ import math
 
 import taichi as ti
 
-from .materials import P, lerp_phase, viscosity
+from .materials import lerp_phase, viscosity
 
 SQRT23 = math.sqrt(2.0 / 3.0)
 
@@ -46,7 +46,7 @@ def perzyna_update(
     strain, hardening variable and deviator follow eqs. 42-45.
     """
     E = lerp_phase(mat, m, xi, "E_c", "E_m")
-    nu = mat[m, P["nu"]]
+    nu = lerp_phase(mat, m, xi, "nu", "nu_m")
     mu = E / (2.0 * (1.0 + nu))
     K = E / (3.0 * (1.0 - 2.0 * nu))
     I3 = ti.Matrix.identity(float, 3)

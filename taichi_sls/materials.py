@@ -32,6 +32,7 @@ P_NAMES = (
     "alpha_m",
     "beta",
     "nu",
+    "nu_m",
     "E_c",
     "E_m",
     "sy_c",
@@ -73,6 +74,7 @@ def material_row(m: Material, T_ref_C: float) -> "np.ndarray":
         alpha_m=m.expansion_liquid_1_K,
         beta=m.solidification_dilatation,
         nu=m.poisson,
+        nu_m=m.poisson_liquid,
         E_c=m.youngs_solid_Pa,
         E_m=m.youngs_liquid_Pa,
         sy_c=m.yield_solid_Pa,
@@ -102,11 +104,14 @@ def p_wave_modulus(E: float, nu: float) -> float:
 def stability_limits(m: Material, h: float) -> dict[str, float]:
     """Time-step limits (s) of one material on grid spacing h (m), MODEL.md / eqs. 46-48.
 
-    The elastic limit uses the P-wave modulus of the stiffer phase; the thermal limit the
-    smallest heat capacity and largest conductivity.
+    The elastic limit uses the larger P-wave modulus of the two phases, each with its own nu;
+    the thermal limit the smallest heat capacity and largest conductivity.
     """
-    E = max(m.youngs_solid_Pa, m.youngs_liquid_Pa)
-    c_wave = math.sqrt(p_wave_modulus(E, m.poisson) / m.density_kg_m3)
+    M = max(
+        p_wave_modulus(m.youngs_solid_Pa, m.poisson),
+        p_wave_modulus(m.youngs_liquid_Pa, m.poisson_liquid),
+    )
+    c_wave = math.sqrt(M / m.density_kg_m3)
     k = max(m.conductivity_solid_W_mK, m.conductivity_liquid_W_mK)
     c = min(m.heat_capacity_solid_J_kgK, m.heat_capacity_liquid_J_kgK)
     out = {"elastic": h / c_wave, "thermal": h * h * m.density_kg_m3 * c / (4 * k)}

@@ -31,6 +31,7 @@ class Scene:
     material: np.ndarray  # (N,) material index
     T0_C: np.ndarray  # (N,) initial temperature (C)
     v0: np.ndarray  # (N, 2) initial velocity (m/s)
+    p0: np.ndarray  # (N,) initial in-plane pressure (Pa): surface_tension.initial_stress
     material_names: list[str]
     table1_nodes: int  # nodes of domain plus ghost layer (what the paper's Table 1 counts)
 
@@ -77,6 +78,22 @@ def _verification_initial(
         T0_C += v.rise_C * np.exp(-r2 / (2.0 * v.sigma_um**2))
 
 
+def laplace_pressure(case: Case, body) -> float:
+    """Initial in-plane pressure of a body (Pa): gamma/R for a disc (Young-Laplace in 2D) with
+    ``surface_tension.initial_stress = "laplace"`` and surface tension on, else 0. A powder
+    particle at the preheat temperature has long been in equilibrium with its surface tension;
+    started stress-free, the soft discs are compressed by it at t = 0, which opens the neck
+    (README: the nolaser case)."""
+    ph = case.physics
+    if (
+        case.surface_tension.initial_stress != "laplace"
+        or not (ph.surface_tension and ph.mechanics)
+        or body.shape != "disc"
+    ):
+        return 0.0
+    return case.materials[body.material].surface_tension_N_m / (body.radius_um * 1e-6)
+
+
 def build_scene(case: Case) -> Scene:
     """Seed the points of every body (a point belongs to the first body that holds it)."""
     h_um = case.grid.spacing_um
@@ -91,7 +108,7 @@ def build_scene(case: Case) -> Scene:
     PX, PY = PX.ravel(), PY.ravel()
     taken = np.zeros(PX.shape, dtype=bool)
     names = list(case.materials)
-    xs, bodies, mats, temps, vels = [], [], [], [], []
+    xs, bodies, mats, temps, vels, pres = [], [], [], [], [], []
     for bi, b in enumerate(case.bodies):
         sel = _inside(b, PX, PY) & ~taken
         taken |= sel
@@ -108,6 +125,7 @@ def build_scene(case: Case) -> Scene:
         T = case.thermal.initial_C if b.temperature_C is None else b.temperature_C
         temps.append(np.full(k, T))
         vels.append(np.tile(np.asarray(b.velocity_m_s, dtype=float), (k, 1)))
+        pres.append(np.full(k, laplace_pressure(case, b)))
     x = np.concatenate(xs) * 1e-6
     T0_C, v0 = np.concatenate(temps), np.concatenate(vels)
     _verification_initial(case, x, np.concatenate(bodies), T0_C, v0)
@@ -127,6 +145,7 @@ def build_scene(case: Case) -> Scene:
         material=np.concatenate(mats),
         T0_C=T0_C,
         v0=v0,
+        p0=np.concatenate(pres),
         material_names=names,
         table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g),
     )

@@ -11,7 +11,8 @@ import numpy as np
 import taichi as ti
 
 from .case import Case
-from .materials import KELVIN, N_PARAMS, enthalpy, material_row, solid_fraction
+from .constitutive import embed3, perzyna_update
+from .materials import KELVIN, N_PARAMS, enthalpy, lerp_phase, material_row, solid_fraction
 from .scene import Scene
 
 TRANSFERS = {"flip": 0, "pic_flip": 1, "apic": 2}
@@ -185,6 +186,8 @@ class State:
         self.t[None] = 0.0
         self.T_peak[None] = float(np.max(sc.T0_C + KELVIN))
         self._init_points()
+        if np.any(sc.p0 != 0.0):
+            self._prestress(sc.p0)
 
     @ti.kernel
     def _init_points(self):
@@ -200,6 +203,35 @@ class State:
             self.de_iso[p] = 0.0
             self.H[p] = enthalpy(self.matp, self.mat[p], self.T[p])
             self.xi[p] = solid_fraction(self.matp, self.mat[p], self.T[p])
+
+    @ti.kernel
+    def _prestress(self, p0: ti.types.ndarray()):
+        """The elastic strain that carries an in-plane pressure p0 (plane strain, eps_zz = 0:
+        eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at each point's initial moduli, and its stress
+        under the case's stress reading."""
+        for p in range(self.n_points):
+            if p0[p] != 0.0:
+                m = self.mat[p]
+                xi = self.xi[p]
+                E = lerp_phase(self.matp, m, xi, "E_c", "E_m")
+                nu = lerp_phase(self.matp, m, xi, "nu", "nu_m")
+                lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
+                eps = ti.Matrix.identity(float, self.dim) * (-p0[p] / (2.0 * lam_mu))
+                self.eps[p] = eps
+                z = ti.Matrix.zero(float, 3, 3)
+                self.sigma[p] = perzyna_update(
+                    self.matp,
+                    m,
+                    embed3(eps),
+                    z,
+                    0.0,
+                    0.0,
+                    xi,
+                    self.T[p],
+                    1.0,
+                    False,
+                    self.paper_stress,
+                )[0]
 
     def node_position(self, i: int, j: int) -> tuple[float, float]:
         return ((i - self.off) * self.h, (j - self.off) * self.h)

@@ -10,7 +10,7 @@ from conftest import make_case
 from taichi_sls import verification as ver
 from taichi_sls.case import Material
 from taichi_sls.constitutive import embed3, perzyna_update
-from taichi_sls.materials import material_row
+from taichi_sls.materials import material_row, p_wave_modulus, stability_limits
 from taichi_sls.shape import STENCIL, node_weight, stencil
 from taichi_sls.simulation import Simulation, init_taichi
 
@@ -166,3 +166,47 @@ def test_musl_conserves_momentum():
     sim.advance(200)
     p1 = (m[:, None] * st.v.to_numpy()).sum(axis=0)
     np.testing.assert_allclose(p1, p0, rtol=1e-12)
+
+
+def test_melt_uses_its_own_poisson_ratio():
+    """materials.poisson_liquid: the melt's nu (default 0.49, nearly incompressible) above T_m,
+    ``poisson`` below T_c, interpolated in the solid fraction like E (eq. 33)."""
+    init_taichi(optimize=False)
+    m = Material(youngs_solid_Pa=1e5, youngs_liquid_Pa=1e4, poisson=0.42, poisson_liquid=0.49)
+    row = material_row(m, 0.0)
+    mat = ti.field(float, (1, len(row)))
+    mat.from_numpy(row[None, :])
+    xis = (1.0, 0.5, 0.0)
+    out = ti.Matrix.field(3, 3, float, len(xis))
+
+    @ti.kernel
+    def stress(exx: float, eyy: float):
+        e = embed3(ti.Matrix([[exx, 0.0], [0.0, eyy]]))
+        z = ti.Matrix.zero(float, 3, 3)
+        for k in ti.static(range(len(xis))):
+            out[k] = perzyna_update(mat, 0, e, z, 0.0, 0.0, xis[k], 500.0, 1e-3, False, False)[0]
+
+    exx, eyy = 1e-3, -4e-4
+    stress(exx, eyy)
+    e = np.diag([exx, eyy, 0.0])
+    for k, xi in enumerate(xis):
+        E = xi * 1e5 + (1 - xi) * 1e4
+        nu = xi * 0.42 + (1 - xi) * 0.49
+        mu, lam = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+        expect = lam * np.trace(e) * np.eye(3) + 2 * mu * e
+        np.testing.assert_allclose(out.to_numpy()[k], expect, rtol=1e-12)
+    assert Material().poisson_liquid == 0.49  # the default; the paper's reading: set 0.42
+
+
+def test_elastic_limit_uses_the_stiffer_phase_with_its_own_nu():
+    """The elastic limit of eq. 46 takes the larger P-wave modulus of the two phases, each with
+    its own nu: a nearly incompressible melt can set it although its E is the smaller."""
+    h = 2e-6
+    base = dict(youngs_solid_Pa=1e5, youngs_liquid_Pa=1e4, poisson=0.42)
+    M_solid = p_wave_modulus(1e5, 0.42)
+    lim = stability_limits(Material(**base, poisson_liquid=0.49), h)["elastic"]
+    assert lim == pytest.approx(h / np.sqrt(M_solid / 1020.0), rel=1e-12)  # the solid governs
+    lim = stability_limits(Material(**base, poisson_liquid=0.499), h)["elastic"]
+    M_melt = p_wave_modulus(1e4, 0.499)
+    assert M_melt > M_solid
+    assert lim == pytest.approx(h / np.sqrt(M_melt / 1020.0), rel=1e-12)
