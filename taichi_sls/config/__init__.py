@@ -1,0 +1,37 @@
+"""Case files: the validated schema, TOML loading with ``--set`` overrides, and the generated
+key reference. The lowest layer: it imports nothing else of the package."""
+
+from .bodies import Body, Disc, Polygon, Rect
+from .errors import CaseError
+from .loading import (
+    apply_override,
+    bundled_case,
+    bundled_cases,
+    case_from_dict,
+    case_to_dict,
+    case_to_toml,
+    deep_update,
+    load_case,
+    read_toml,
+)
+from .materials import Material
+from .schema import Case
+
+__all__ = [
+    "Body",
+    "Case",
+    "CaseError",
+    "Disc",
+    "Material",
+    "Polygon",
+    "Rect",
+    "apply_override",
+    "bundled_case",
+    "bundled_cases",
+    "case_from_dict",
+    "case_to_dict",
+    "case_to_toml",
+    "deep_update",
+    "load_case",
+    "read_toml",
+]

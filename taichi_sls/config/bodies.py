@@ -1,0 +1,96 @@
+"""Bodies of a case: discs, rectangles and polygons, each seeded with material points (lengths
+in um)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, field_validator
+
+from .model import Model, Pair
+
+
+class BodyBase(Model):
+    material: str = Field("PA12", description="name of a [materials.NAME] table")
+    temperature_C: float | None = Field(
+        None, description="initial temperature; default thermal.initial_C"
+    )
+    velocity_m_s: Pair = Field([0.0, 0.0], description="initial velocity (m/s)")
+
+
+class Disc(BodyBase):
+    shape: Literal["disc"] = Field("disc", description="disc, rect or polygon")
+    center_um: Pair = Field([20.0, 20.0], description="disc centre (um)")
+    radius_um: float = Field(20.0, gt=0, description="disc radius (um)")
+    perturbation: float = Field(
+        0.0,
+        gt=-0.5,
+        lt=0.5,
+        description="outline r = R (1 + perturbation cos(mode theta)), |value| < 0.5",
+    )
+    mode: int = Field(2, ge=2, description="shape mode n >= 2 of the perturbation")
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        (cx, cy), r = self.center_um, self.radius_um * (1.0 + abs(self.perturbation))
+        return (cx - r, cy - r), (cx + r, cy + r)
+
+    def perimeter_um(self) -> float:
+        return 2 * math.pi * self.radius_um
+
+
+class Rect(BodyBase):
+    shape: Literal["rect"] = Field(description="disc, rect or polygon")
+    min_um: Pair = Field([0.0, 0.0], description="rectangle lower-left corner (um)")
+    max_um: Pair = Field([10.0, 10.0], description="rectangle upper-right corner (um)")
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        return (self.min_um[0], self.min_um[1]), (self.max_um[0], self.max_um[1])
+
+    def perimeter_um(self) -> float:
+        return 2 * (self.max_um[0] - self.min_um[0] + self.max_um[1] - self.min_um[1])
+
+
+class Polygon(BodyBase):
+    shape: Literal["polygon"] = Field(description="disc, rect or polygon")
+    vertices_um: list[Pair] = Field(
+        [],
+        description="outline vertices [[x, y], ...] (um), in order, either sense; or give "
+        "vertices_file",
+    )
+    vertices_file: str | None = Field(
+        None,
+        description="file of outline vertices, one 'x y' pair (um) per line ('#' comments), "
+        "relative to the case file",
+    )
+
+    @field_validator("vertices_file")
+    @classmethod
+    def _readable(cls, v: str | None) -> str | None:
+        if v is not None and not Path(v).is_file():
+            raise ValueError("no such file")
+        return v
+
+    def outline_um(self) -> list[list[float]]:
+        """The vertices, from the table or the file."""
+        if self.vertices_file is None:
+            return [list(p) for p in self.vertices_um]
+        rows = []
+        for line in Path(self.vertices_file).read_text().splitlines():
+            line = line.split("#", 1)[0].strip()
+            if line:
+                x, y = (float(s) for s in line.replace(",", " ").split())
+                rows.append([x, y])
+        return rows
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        xs, ys = zip(*self.outline_um(), strict=True)
+        return (min(xs), min(ys)), (max(xs), max(ys))
+
+    def perimeter_um(self) -> float:
+        v = self.outline_um()
+        return sum(math.dist(v[i], v[i - 1]) for i in range(len(v)))
+
+
+Body = Annotated[Disc | Rect | Polygon, Field(discriminator="shape")]

@@ -1,0 +1,155 @@
+"""Case files on disk: TOML in, ``--set`` overrides, validation, TOML out, bundled cases."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+from pydantic import ValidationError
+
+from .errors import CaseError, case_error
+from .schema import Case
+
+
+def read_toml(path: str | Path, what: str, error: type[Exception] = CaseError) -> dict:
+    """Parse a TOML file, turning a missing file or bad syntax into ``error`` with the path."""
+    path = Path(path)
+    if not path.is_file():
+        raise error(f"{what} {str(path)!r} does not exist")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise error(f"{path}: not valid TOML: {e}") from None
+
+
+def deep_update(base: dict, extra: dict) -> dict:
+    """A copy of ``base`` with the nested dict ``extra`` merged in (lists are replaced)."""
+    out = copy.deepcopy(base)
+    for k, v in extra.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = deep_update(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def parse_override(text: str, what: str = "--set") -> tuple[list[str], Any]:
+    """``section.key=value`` -> (key path, value); the value is read as TOML, and a bare word
+    that is no TOML value is a string (``--set solver.transfer=flip``)."""
+    if "=" not in text:
+        raise CaseError(f"{what} {text!r}: expected section.key=value")
+    path, raw = text.split("=", 1)
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    return path.strip().split("."), value
+
+
+def add_set_argument(parser: Any, help: str) -> None:
+    """The ``--set KEY=VALUE`` option of the command lines (an argparse parser)."""
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help=help)
+
+
+def apply_override(data: dict, text: str) -> None:
+    """Apply one ``section.key=value`` override to raw case data. List items: ``bodies.0.radius_um``
+    or ``lasers.0.power_W``."""
+    parts, value = parse_override(text)
+    node: Any = data
+    for i, p in enumerate(parts[:-1]):
+        if isinstance(node, list):
+            if not p.isdigit() or int(p) >= len(node):
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is no list index")
+            node = node[int(p)]
+        else:
+            if p not in node and parts[i + 1].isdigit():
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is no list")
+            node = node.setdefault(p, {})
+            if not isinstance(node, (dict, list)):
+                raise CaseError(f"--set {text!r}: {'.'.join(parts[: i + 1])} is not a table")
+    last = parts[-1]
+    if isinstance(node, list):
+        if not last.isdigit() or int(last) >= len(node):
+            raise CaseError(f"--set {text!r}: {last!r} is no list index")
+        node[int(last)] = value
+    else:
+        node[last] = value
+
+
+def case_from_dict(data: dict) -> Case:
+    """Build and validate a :class:`Case` from raw TOML data."""
+    try:
+        return Case.model_validate(data)
+    except ValidationError as e:
+        raise case_error(e, Case, data) from None
+
+
+def _resolve_files(data: dict, folder: Path) -> None:
+    """Body files named relative to the case file, made absolute."""
+    for b in data.get("bodies", []) if isinstance(data.get("bodies"), list) else []:
+        f = b.get("vertices_file") if isinstance(b, dict) else None
+        if isinstance(f, str) and not Path(f).is_absolute():
+            b["vertices_file"] = str((folder / f).resolve())
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
+    """Read a case file (a path, or the name of a bundled case), apply ``--set`` overrides,
+    validate, return the :class:`Case`."""
+    path = find_case(path)
+    data = read_toml(path, "case file")
+    for o in overrides or []:
+        apply_override(data, o)
+    if "case" not in data or "name" not in data.get("case", {}):
+        data.setdefault("case", {})["name"] = path.stem
+    _resolve_files(data, path.parent)
+    return case_from_dict(data)
+
+
+def case_to_dict(case: Case) -> dict:
+    """The resolved case as plain data (None values dropped: TOML has no null)."""
+    return case.model_dump(exclude_none=True)
+
+
+def case_to_toml(case: Case) -> str:
+    """The resolved case as TOML text: every default filled in; it loads back to the same case."""
+    return tomli_w.dumps(case_to_dict(case))
+
+
+# ---------------------------------------------------------------------------- bundled cases
+
+
+def bundled_root() -> Path:
+    """The folder of the case files shipped with the package (``taichi_sls/cases``)."""
+    return Path(str(resources.files("taichi_sls") / "cases"))
+
+
+def bundled_cases(folder: str = "") -> list[Path]:
+    """The bundled case files (of a subfolder such as ``verification``), sorted by name."""
+    return sorted((bundled_root() / folder).glob("*.toml"))
+
+
+def bundled_case(name: str) -> Path:
+    """A bundled case by name (``power25W``, ``verification/laplace``)."""
+    p = bundled_root() / f"{name}.toml"
+    if not p.is_file():
+        names = ", ".join(q.stem for q in bundled_cases())
+        raise CaseError(f"case {name!r}: no such bundled case; bundled: {names}")
+    return p
+
+
+def find_case(path: str | Path) -> Path:
+    """A case file as given; failing that, a bundled one by name or by its path under
+    ``cases/`` (so ``cases/power25W.toml`` works from any folder once installed)."""
+    p = Path(path)
+    if p.is_file():
+        return p
+    name = p.with_suffix("").as_posix()
+    name = name.split("cases/", 1)[1] if "cases/" in name else name
+    q = bundled_root() / f"{name}.toml"
+    if q.is_file():
+        return q
+    raise CaseError(f"case file {str(path)!r} does not exist")

@@ -1,0 +1,60 @@
+"""The material table of a case (``[materials.NAME]``)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import AfterValidator, Field
+
+from .model import Model
+
+
+def _poisson(v: float) -> float:
+    if not -1.0 < v < 0.5:
+        raise ValueError("must lie in (-1, 0.5)")
+    return v
+
+
+Poisson = Annotated[float, AfterValidator(_poisson)]
+
+
+class Material(Model):
+    """Every parameter of the paper's Table 3. `_solid` holds for T <= T_c, `_liquid` for
+    T >= T_m; in between they are interpolated linearly in the solid fraction (eq. 33)."""
+
+    density_kg_m3: float = Field(1020.0, gt=0, description="rho")
+    conductivity_solid_W_mK: float = Field(0.28, gt=0, description="k_c")
+    conductivity_liquid_W_mK: float = Field(0.24, gt=0, description="k_m")
+    heat_capacity_solid_J_kgK: float = Field(2700.0, gt=0, description="c_c")
+    heat_capacity_liquid_J_kgK: float = Field(2700.0, gt=0, description="c_m")
+    latent_heat_J_kg: float = Field(50e3, ge=0, description="l_s")
+    melt_C: float = Field(175.0, description="T_m")
+    crystallization_C: float = Field(146.0, description="T_c (< T_m)")
+    expansion_solid_1_K: float = Field(15e-5, description="alpha for T <= T_c")
+    expansion_liquid_1_K: float = Field(5e-5, description="alpha for T >= T_m")
+    solidification_dilatation: float = Field(
+        0.015, description="beta: d(eps_m) = beta d(xi_s) 1 (eq. 37); 0.015 = the paper's 1.5 %"
+    )
+    poisson: Poisson = Field(0.42, description="nu for T <= T_c, in (-1, 0.5) (Table 3)")
+    poisson_liquid: Poisson = Field(
+        0.49,
+        description="nu for T >= T_m, in (-1, 0.5); interpolated in xi_s like E. Default 0.49: a "
+        "melt is nearly incompressible; the paper's one nu (set 0.42 for its reading) makes the "
+        "10 kPa melt's bulk modulus 21 kPa, which its own Laplace pressure compresses by 8 % in "
+        "area and so opens the neck (docs/model.md). 0.49 keeps the melt's P-wave modulus below "
+        "the solid's: the same time step",
+    )
+    youngs_solid_Pa: float = Field(1e5, gt=0, description="E for T <= T_c")
+    youngs_liquid_Pa: float = Field(1e4, gt=0, description="E for T >= T_m")
+    yield_solid_Pa: float = Field(1e5, ge=0, description="sigma_Y for T <= T_c")
+    yield_liquid_Pa: float = Field(1e4, ge=0, description="sigma_Y for T >= T_m")
+    hardening_solid_Pa: float = Field(1e5, ge=0, description="H for T <= T_c")
+    hardening_liquid_Pa: float = Field(0.0, ge=0, description="H for T >= T_m")
+    viscosity_model: Literal["exponential", "constant"] = Field(
+        "exponential",
+        description="exponential: eta = A exp(-b T[C]) (Table 3); constant: eta = viscosity_Pas",
+    )
+    viscosity_A_Pas: float = Field(130219.0, gt=0, description="A of the exponential law (Pa s)")
+    viscosity_b_1_C: float = Field(0.02, ge=0, description="b of the exponential law (1/C)")
+    viscosity_Pas: float = Field(1e3, gt=0, description="constant viscosity (Pa s)")
+    surface_tension_N_m: float = Field(36.3e-3, ge=0, description="gamma (N/m)")

@@ -1,0 +1,271 @@
+"""The tables of a case file other than bodies and materials."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+from pydantic import AfterValidator, BeforeValidator, Field
+
+from .model import Model, Pair
+
+
+def _auto_or_positive(v: Any) -> float | str:
+    if v == "auto" and isinstance(v, str):
+        return v
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ValueError('expected a positive number or "auto"')
+    if not v > 0:
+        raise ValueError("must be > 0")
+    return float(v)
+
+
+def _auto_or_count(v: Any) -> int | str:
+    if v == "auto" and isinstance(v, str):
+        return v
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ValueError('expected an integer >= 1 or "auto"')
+    return v
+
+
+# validated before the union sees them, so that the message says what is allowed
+AutoPositive = Annotated[float | str, BeforeValidator(_auto_or_positive)]
+AutoCount = Annotated[int | str, BeforeValidator(_auto_or_count)]
+
+
+class CaseInfo(Model):
+    name: str = Field("case", description="case name; default output folder is out/<name>")
+    description: str = Field("", description="free text")
+
+
+class Grid(Model):
+    spacing_um: float = Field(2.0, gt=0, description="grid spacing h (um)")
+    points_per_cell: int = Field(
+        2,
+        gt=0,
+        le=8,
+        description="material points per cell along each axis (2 -> 2x2 quarter points)",
+    )
+    ghost_cells: int = Field(
+        1,
+        ge=0,
+        le=8,
+        description="extra cells beyond left/right/bottom walls (surface tension stencil)",
+    )
+
+
+class Domain(Model):
+    width_um: float = Field(80.0, gt=0, description="domain width (um); x from 0")
+    height_um: float = Field(48.0, gt=0, description="domain height (um); y from 0 (baseplate)")
+
+
+class Wall(Model):
+    mechanical: Literal["slip", "stick", "open"] = Field(
+        "slip", description="slip: zero normal velocity"
+    )
+    thermal: Literal["insulated", "fixed"] = Field("insulated", description="heat flux condition")
+    temperature_C: float = Field(140.0, description="wall temperature when thermal = fixed")
+
+
+class Boundary(Model):
+    """Bottom wall default: `thermal = "fixed"` at 140 C; top wall default:
+    `mechanical = "open"`."""
+
+    left: Wall = Field(default_factory=Wall)
+    right: Wall = Field(default_factory=Wall)
+    bottom: Wall = Field(default_factory=lambda: Wall(thermal="fixed"))
+    top: Wall = Field(default_factory=lambda: Wall(mechanical="open"))
+
+    def walls(self) -> tuple[Wall, Wall, Wall, Wall]:
+        """(left, right, bottom, top): the order of the solver's wall codes."""
+        return self.left, self.right, self.bottom, self.top
+
+
+class Physics(Model):
+    mechanics: bool = Field(True, description="move the points (off: frozen geometry, heat only)")
+    thermal: bool = Field(True, description="heat conduction and enthalpy")
+    surface_tension: bool = Field(True, description="capillary force (surface_tension.method)")
+    plasticity: bool = Field(True, description="Perzyna return map (off: linear elastic)")
+    thermal_strain: bool = Field(
+        True, description="thermal and transformation strains (eqs. 36-37)"
+    )
+    gravity_m_s2: Pair = Field([0.0, -9.81], description="body force per mass")
+
+
+class Time(Model):
+    dt_s: AutoPositive = Field(
+        "auto", description='time step (s), or "auto" from the stability limits'
+    )
+    end_s: float = Field(1e-3, gt=0, description="simulated end time (s)")
+    safety: float = Field(0.4, gt=0, description='fraction of the stability limit for "auto"')
+    allow_unstable_dt: bool = Field(False, description="let a fixed dt exceed the stability limit")
+    heat_every: AutoCount = Field(
+        "auto",
+        description="conduction and laser every N mechanical steps, with a heat step of N dt "
+        '(the thermal limit is ~100x the elastic one); "auto": the largest N with N dt <= '
+        "heat_step_fraction x the thermal limit; 1: every step",
+    )
+    heat_step_fraction: float = Field(
+        0.1,
+        gt=0,
+        le=1.0,
+        description="heat step as a fraction of the thermal stability limit for heat_every = "
+        '"auto"',
+    )
+
+
+class Solver(Model):
+    transfer: Literal["apic", "flip", "pic_flip"] = Field(
+        "pic_flip",
+        description="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + "
+        "(1-flip_ratio)*PIC",
+    )
+    update: Literal["usl", "musl"] = Field(
+        "usl",
+        description="usl: eqs. 14-17 as printed; musl: move points with the remapped grid "
+        "velocity (bounded on nearly empty nodes, but slows capillary flow)",
+    )
+    flip_ratio: float = Field(
+        0.9, ge=0, le=1, description="FLIP share of the pic_flip blend, in [0, 1]"
+    )
+    arch: Literal["cpu", "gpu"] = Field("cpu", description="Taichi backend")
+    layout: Literal["auto", "serial", "parallel"] = Field(
+        "auto",
+        description="serial: many steps per kernel call, loops serialized; parallel: one call "
+        "per step, every stage a parallel loop; auto: serial on CPU (faster at every size "
+        "measured on 2 cores, to 1M points), parallel on GPU",
+    )
+    active_region: bool = Field(
+        True,
+        description="grid loops only over the nodes that material has reached (plus the "
+        "stencil, level-set band and smoothing margin); false: every node, every step",
+    )
+    precision: Literal["f64", "f32"] = Field("f64", description="floating point precision")
+    small_mass: float = Field(
+        1e-9, ge=0, description="nodes below this fraction of a full cell's mass are skipped"
+    )
+    stress_reading: Literal["model", "paper"] = Field(
+        "model",
+        description="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md); paper: eq. 39 "
+        "and p = lambda tr(eps) as printed",
+    )
+    optimize: bool = Field(
+        False,
+        description="Taichi's advanced optimisation: ~1.5x faster steps after a ~100 s "
+        "one-off compile (cached on disk); false compiles in ~5-10 s",
+    )
+    fast_math: bool = Field(
+        True,
+        description="let the compiler reorder floating-point arithmetic (Taichi's fast_math); "
+        "false: strict IEEE order, bitwise reproducible across changes of code structure",
+    )
+    strain: Literal["small"] = Field(
+        "small", description="small: accumulated eps += sym(L) dt (eqs. 16-17; not objective)"
+    )
+
+
+class Thermal(Model):
+    initial_C: float = Field(140.0, description="initial temperature of every body without its own")
+    enthalpy_reference_C: float = Field(0.0, description="temperature where enthalpy is zero")
+
+
+class Laser(Model):
+    power_W: float = Field(25.0, ge=0, description="P")
+    spot_radius_um: float = Field(50.0, gt=0, description="r_0")
+    absorptivity: float = Field(
+        0.85, ge=0, description="A (fraction, MODEL.md reads 0.85 % as 0.85)"
+    )
+    penetration_depth_um: float = Field(100.0, gt=0, description="eta_l")
+    depth_factor: float = Field(0.6, ge=0, description="the 0.6 prefactor of eq. 31")
+    on_s: float = Field(0.0, ge=0, description="switch-on time (s)")
+    off_s: float = Field(20e-6, ge=0, description="switch-off time (s)")
+    x_start_um: float = Field(40.0, description="beam centre at on_s (um)")
+    speed_m_s: float = Field(0.0, description="scan speed along +x (m/s); 0 = stationary")
+    x_end_um: float | None = Field(
+        None, description="beam switches off when its centre passes this x"
+    )
+    top_um: float | None = Field(
+        None, description="y_l, top of the powder; default: highest body top"
+    )
+    source_units: Literal["W_per_m3", "W_per_kg"] = Field(
+        "W_per_m3",
+        description="eq. 31 read as W/m^3 (MODEL.md) or, as printed in eq. 3, W/kg multiplied "
+        "by rho",
+    )
+    depth_sign: Literal["decay", "paper"] = Field(
+        "decay",
+        description="decay: exp(-(y_l - y)/eta) (MODEL.md); paper: exp(+(y_l - y)/eta) as printed",
+    )
+
+
+def _point_radius(v: float) -> float:
+    if not v > math.sqrt(2) / 4:
+        raise ValueError(
+            f"must exceed sqrt(2)/4 = {math.sqrt(2) / 4:.4f} (interior nodes would read outside)"
+        )
+    return v
+
+
+class SurfaceTension(Model):
+    point_radius_over_h: Annotated[float, AfterValidator(_point_radius)] = Field(
+        0.375,
+        gt=0,
+        description="r_p / h in eq. 21; > sqrt(2)/4 so interior nodes read inside",
+    )
+    band_cells: int = Field(3, gt=0, le=8, description="half-width of the level-set band (cells)")
+    level_set: Literal["redistanced", "raw"] = Field(
+        "redistanced",
+        description="redistanced: signed distance to the eq. 21 zero contour; raw: eq. 21 as "
+        "printed",
+    )
+    level_set_smoothing_passes: int = Field(
+        8, ge=0, le=64, description="binomial smoothing passes over phi before the fit"
+    )
+    smoothing_passes: int = Field(
+        16, ge=0, le=64, description="mass-weighted curvature smoothing passes"
+    )
+    colour_threshold: float = Field(
+        0.0,
+        ge=0,
+        le=0.9,
+        description="CSF acts on nodes above this fraction of a full cell's mass (0: eq. 19 as "
+        "printed)",
+    )
+    zero_net_force: bool = Field(
+        True, description="remove the CSF resultant left by curvature noise (mass-weighted)"
+    )
+    curvature_cap_h: float = Field(
+        0.5, ge=0, description="|kappa| h capped here (0 = no cap); the grid resolves R >= 2h"
+    )
+    curvature_every: AutoCount = Field(
+        "auto",
+        description="rebuild level set and curvature every N steps (the CSF force uses the "
+        'current mass every step); "auto": the largest N with N dt <= curvature_step_fraction '
+        "x the capillary limit. A stale curvature is a delayed restoring force: every 10 steps "
+        "on the paper's fine grid (N dt = the capillary limit) doubled the kinetic energy",
+    )
+    curvature_step_fraction: float = Field(
+        0.25,
+        gt=0,
+        le=1.0,
+        description="curvature age as a fraction of the capillary limit for curvature_every = "
+        '"auto"',
+    )
+    initial_stress: Literal["laplace", "none"] = Field(
+        "laplace",
+        description="laplace: every disc starts in equilibrium with its own surface tension "
+        "(in-plane pressure gamma/R, carried by the elastic strain at its initial temperature; "
+        "other shapes start stress-free); none: every body starts stress-free and its Laplace "
+        "pressure compresses it once the run starts (the paper does not say)",
+    )
+
+
+class Output(Model):
+    frames: int = Field(20, gt=0, le=100000, description="number of output frames over the run")
+    png: bool = Field(True, description="write frames/*.png")
+    gif: bool = Field(True, description="write animation.gif from the frames")
+    vtu: bool = Field(False, description="write ParaView point data (points_*.vtu + points.pvd)")
+    dpi: int = Field(80, gt=0, le=600, description="resolution of the frames")
+    deformation: Literal["displacement", "plastic_strain"] = Field(
+        "displacement", description="what the right-hand panel colours the points by"
+    )

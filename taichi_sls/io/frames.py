@@ -1,0 +1,193 @@
+"""Frame images: the points coloured by temperature (melt outlined) and by deformation.
+
+Plotting is headless (Agg) and reuses one figure across frames so memory stays flat over
+hundreds of frames; the axes box is fixed so that the marker scale is the same in every frame."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+from collections.abc import Iterator
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: the solver runs on machines without a display
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from .atomic import atomic_write_bytes
+
+MELT_LEVEL = 0.5  # liquid fraction drawn as the melt outline
+_MAX_CONTOUR_CELLS = 400  # per axis; bounds the melt-outline grid if points fly far apart
+DEFORM_LABELS = {
+    "displacement": ("|u| [um]", "displacement"),
+    "plastic_strain": ("equivalent plastic strain", "plastic strain"),
+}
+
+
+def _point_spacing(x: np.ndarray, fallback: float) -> float:
+    """Typical particle spacing sqrt(area per point), from a sample of local point densities.
+
+    Counting neighbours within a few nearest-neighbour distances (rather than using the
+    nearest-neighbour distance itself) also covers anisotropic or jittered arrangements.
+    """
+    n = len(x)
+    if n < 2:
+        return fallback
+    rng = np.random.default_rng(0)  # fixed seed: marker size must not flicker between frames
+    sample = x if n <= 64 else x[rng.choice(n, 64, replace=False)]
+
+    def dist2() -> Iterator[np.ndarray]:  # in chunks so memory stays O(16 N), not O(64 N)
+        for i in range(0, len(sample), 16):
+            yield ((sample[i : i + 16, None, :] - x[None]) ** 2).sum(axis=-1)
+
+    # zero distance = self or an exact duplicate
+    nn2 = np.concatenate([np.where(d2 > 0.0, d2, np.inf).min(axis=1) for d2 in dist2()])
+    nn2 = nn2[np.isfinite(nn2)]
+    if nn2.size == 0:
+        return fallback
+    r2 = 9.0 * float(np.median(nn2))
+    counts = np.concatenate([(d2 <= r2).sum(axis=1) for d2 in dist2()])
+    # Upper quantile of counts: points near a free surface see only half a neighbourhood.
+    count = float(np.quantile(counts, 0.75))
+    h = math.sqrt(math.pi * r2 / count)
+    return h if h > 0.0 else fallback
+
+
+def _finite_range(
+    v: np.ndarray, lo: float | None = None, hi: float | None = None
+) -> tuple[float, float]:
+    """Colour limits spanning the finite values and the anchors; never degenerate."""
+    f = v[np.isfinite(v)]
+    vals = [float(f.min()), float(f.max())] if f.size else []
+    vals += [a for a in (lo, hi) if a is not None]
+    if not vals:
+        return 0.0, 1.0
+    vmin, vmax = min(vals), max(vals)
+    if not vmax > vmin:  # uniform field: Normalize would divide by zero
+        vmin, vmax = vmin - (0.0 if lo is not None else 1.0), vmax + 1.0
+    return vmin, vmax
+
+
+def _melt_grid(
+    x: np.ndarray, lf: np.ndarray, h: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Bin liquid fraction on a grid of cell ``h``; empty cells count as solid (0).
+
+    Contouring this grid at 0.5 is robust for any point set (no triangulation that could fail
+    on collinear/duplicate points or bridge gaps between particles), and cheap (bincount).
+    Returns (xc, yc, values) or None when there is no liquid/solid boundary to draw.
+    """
+    ok = np.isfinite(x).all(axis=1)
+    x, lf = x[ok], np.nan_to_num(lf[ok], nan=0.0)
+    if len(x) == 0 or not (lf > MELT_LEVEL).any():
+        return None
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    h = max(h, float((hi - lo).max()) / _MAX_CONTOUR_CELLS, 1e-12)
+    lo = lo - 1.5 * h  # one empty ring all round closes the outline at free surfaces
+    nx, ny = (np.floor((hi - lo) / h).astype(int) + 3).tolist()
+    ij = np.floor((x - lo) / h).astype(int)
+    flat = ij[:, 1] * nx + ij[:, 0]
+    s = np.bincount(flat, weights=lf, minlength=nx * ny)
+    c = np.bincount(flat, minlength=nx * ny)
+    vals = np.divide(s, c, out=np.zeros_like(s), where=c > 0).reshape(ny, nx)
+    if not (vals < MELT_LEVEL).any():
+        return None
+    xc = lo[0] + (np.arange(nx) + 0.5) * h
+    yc = lo[1] + (np.arange(ny) + 0.5) * h
+    return xc, yc, vals
+
+
+def save_png(fig: Figure, path: Path, dpi: int) -> None:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+class FramePainter:
+    """Draws one frame into a reused figure of two panels (temperature, deformation)."""
+
+    def __init__(
+        self, domain_um: tuple[float, float, float, float], melt_C: float, deformation: str
+    ) -> None:
+        self.domain_um = domain_um
+        self.melt_C = melt_C
+        self.deformation = deformation
+        self._fig: Figure | None = None
+
+    def _setup_figure(self) -> None:
+        xmin, xmax, ymin, ymax = self.domain_um
+        panel_w = 4.2  # inches; 2 panels + colour bars stay ~800 px wide at dpi 80
+        panel_h = min(max(panel_w * (ymax - ymin) / (xmax - xmin), 1.5), 6.0)
+        fig = Figure(figsize=(2 * panel_w + 1.4, panel_h + 1.0))
+        FigureCanvasAgg(fig)
+        # Fixed layout (not constrained) so the axes box -- and so the marker scale -- is known
+        # before drawing and identical across frames.
+        fig.subplots_adjust(left=0.06, right=0.93, bottom=0.14, top=0.86, wspace=0.38)
+        axes = fig.subplots(1, 2)
+        cb_label, name = DEFORM_LABELS[self.deformation]
+        self._scatters, self._cbars = [], []
+        for ax, cmap, label, title in zip(
+            axes,
+            ("inferno", "viridis"),
+            ("T [C]", cb_label),
+            ("temperature (cyan: melt)", name),
+            strict=True,
+        ):
+            sc = ax.scatter(
+                np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", linewidths=0
+            )
+            self._cbars.append(fig.colorbar(sc, ax=ax, label=label, fraction=0.046, pad=0.03))
+            self._scatters.append(sc)
+            ax.set_xlim(xmin, xmax)
+            ax.set_ylim(ymin, ymax)
+            ax.set_aspect("equal", adjustable="box")
+            ax.set_xlabel("x [um]")
+            ax.set_ylabel("y [um]")
+            ax.set_title(title, fontsize=10)
+        # Points per micrometre under equal aspect: the tighter of the two directions.
+        pos = axes[0].get_position()
+        w_pt, h_pt = fig.get_figwidth() * pos.width * 72, fig.get_figheight() * pos.height * 72
+        self._pt_per_um = min(w_pt / (xmax - xmin), h_pt / (ymax - ymin))
+        self._axes, self._contour, self._fig = axes, None, fig
+
+    def draw(self, t_s: float, x: np.ndarray, fields: dict[str, np.ndarray]) -> None:
+        if self._fig is None:
+            self._setup_figure()
+        fallback = (
+            self.domain_um[1] - self.domain_um[0]
+        ) / 100  # lone or coincident points: a small visible square
+        h = _point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
+        # Square side 1.5 h so neighbouring markers overlap: reads as a continuous body.
+        size = max((1.5 * h * self._pt_per_um) ** 2, 0.5)
+        T, d = fields["T_C"], fields["deform"]
+        # T range always includes melt_C and |u| starts at 0, so colours keep their meaning.
+        limits = (_finite_range(T, hi=self.melt_C), _finite_range(d, lo=0.0))
+        for sc, v, clim in zip(self._scatters, (T, d), limits, strict=True):
+            sc.set_offsets(x)
+            sc.set_array(v)
+            sc.set_sizes(np.array([size]))
+            sc.set_clim(*clim)
+        if self._contour is not None:
+            with contextlib.suppress(Exception):
+                self._contour.remove()
+            self._contour = None
+        try:
+            grid = _melt_grid(x, fields["liquid_fraction"], 2.0 * h)
+            if grid is not None:
+                self._contour = self._axes[0].contour(
+                    *grid, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
+                )
+        except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame to it
+            self._contour = None
+        self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
+
+    def save(self, path: Path, dpi: int) -> None:
+        save_png(self._fig, path, dpi)
+
+    def close(self) -> None:
+        self._fig = None  # drop the figure; a later draw rebuilds it

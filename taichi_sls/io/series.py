@@ -1,0 +1,125 @@
+"""The time series: one row of monitors per output frame in a CSV rewritten atomically (so it
+is always valid), and its plot."""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from .atomic import atomic_write_text
+from .frames import save_png
+
+SERIES_LABELS = {
+    "contact_line_um": "contact line [um]",
+    "T_max_C": "peak temperature [C]",
+}
+MONITORED = ("contact_line_um", "T_max_C")
+
+
+def fmt_cell(v: Any) -> str:
+    """CSV cell: ints exact, floats round-trip exact (repr), NaN/inf as nan/inf, None empty."""
+    if v is None:
+        return ""
+    if isinstance(v, (bool, np.bool_)):
+        return str(int(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    return str(v)
+
+
+class SeriesWriter:
+    """Rows of monitors -> ``path`` (CSV). The first row fixes the column order; keys first seen
+    later become new columns at the end (earlier rows left empty there) rather than being
+    dropped."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        self.header: list[str] = []
+        self._lines: list[list[str]] = []  # formatted cells; padded when the header grows
+
+    def row(self, values: dict[str, float]) -> None:
+        """Append a row and rewrite the file atomically."""
+        for k in values:
+            if k not in self.header:
+                self.header.append(k)
+        self._lines.append([fmt_cell(values.get(k)) for k in self.header])
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(self.header)
+        n = len(self.header)
+        for cells in self._lines:
+            w.writerow(cells + [""] * (n - len(cells)))
+        atomic_write_text(self.path, buf.getvalue())
+
+    def resume(self) -> None:
+        """Keep the rows an earlier run wrote."""
+        if self.path.is_file():
+            rows = list(csv.reader(self.path.open()))
+            if rows:
+                self.header = rows[0]
+                self._lines = rows[1:]
+
+
+def plot_series(csv_path: Path, png_path: Path, columns: list[str]) -> bool:
+    """Plot each of ``columns`` (those present) against ``t_s`` in microseconds, one panel each.
+
+    Returns False (and writes nothing) when there is nothing to plot: fewer than two rows, no
+    ``t_s`` column or none of ``columns`` present. Unparseable cells plot as gaps.
+    """
+    csv_path, png_path = Path(csv_path), Path(png_path)
+    if not csv_path.is_file():
+        return False
+    with csv_path.open(newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    present = [c for c in columns if rows and c in rows[0]]
+    if len(rows) < 2 or "t_s" not in rows[0] or not present:
+        return False
+
+    def col(name: str) -> np.ndarray:
+        out = np.full(len(rows), np.nan)
+        for i, r in enumerate(rows):
+            with contextlib.suppress(TypeError, ValueError):
+                out[i] = float(r[name])
+        return out
+
+    t_us = col("t_s") * 1e6
+    fig = Figure(figsize=(4.2 * len(present), 3.2), layout="constrained")
+    FigureCanvasAgg(fig)
+    for ax, name in zip(fig.subplots(1, len(present), squeeze=False)[0], present, strict=True):
+        ax.plot(t_us, col(name), lw=1.2)
+        ax.set_xlabel("t [us]")
+        ax.set_ylabel(SERIES_LABELS.get(name, name))
+        ax.grid(True, alpha=0.3)
+    save_png(fig, png_path, dpi=100)
+    return True
+
+
+def read_series(path: str | Path) -> dict[str, np.ndarray]:
+    """A ``timeseries.csv`` as one float array per column (empty cells as NaN)."""
+    with Path(path).open(newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return {}
+    out = {}
+    for k in rows[0]:
+        vals = []
+        for r in rows:
+            try:
+                vals.append(float(r[k]))
+            except (TypeError, ValueError):
+                vals.append(np.nan)
+        out[k] = np.array(vals)
+    return out

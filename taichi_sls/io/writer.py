@@ -1,0 +1,120 @@
+"""Everything a run writes into its output folder: case copy, frames, VTU points, time series
+and its plot, summary, GIF.
+
+Every file is written atomically (io/atomic.py), so a run that is interrupted -- Ctrl-C,
+wall-clock limit, crash -- leaves each output either old or complete, never truncated."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import atomic_write_text
+from .frames import DEFORM_LABELS, FramePainter
+from .gif import write_gif
+from .series import MONITORED, SeriesWriter, plot_series
+from .summary import write_summary
+from .vtu import VtuWriter
+
+
+class OutputWriter:
+    """Writes everything a run produces into ``out_dir``; see the module docstring."""
+
+    def __init__(
+        self,
+        out_dir: Path,
+        *,
+        domain_um: tuple[float, float, float, float],
+        melt_C: float,
+        png: bool = True,
+        gif: bool = True,
+        vtu: bool = False,
+        dpi: int = 80,
+        deformation: str = "displacement",
+    ) -> None:
+        if deformation not in DEFORM_LABELS:
+            raise ValueError(
+                f"deformation={deformation!r}; allowed: {', '.join(sorted(DEFORM_LABELS))}"
+            )
+        xmin, xmax, ymin, ymax = (float(v) for v in domain_um)
+        if not (xmax > xmin and ymax > ymin):
+            raise ValueError(f"domain_um={domain_um!r} must be (xmin, xmax, ymin, ymax), min<max")
+        self.out_dir = Path(out_dir)
+        self.png, self.gif, self.vtu = png, gif, vtu
+        self.dpi = int(dpi)
+        self.frames_written = 0
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        (self.out_dir / "frames").mkdir(exist_ok=True)
+        self._png_paths: dict[int, Path] = {}
+        self.series = SeriesWriter(self.out_dir / "timeseries.csv")
+        self._painter = FramePainter((xmin, xmax, ymin, ymax), float(melt_C), deformation)
+        self._vtu = VtuWriter(self.out_dir)
+
+    # ----------------------------------------------------------------- simple files
+
+    def write_case(self, toml_text: str) -> None:
+        atomic_write_text(self.out_dir / "case.toml", toml_text)
+
+    def summary(self, data: dict) -> None:
+        write_summary(self.out_dir / "summary.json", data)
+
+    def row(self, values: dict[str, float]) -> None:
+        """Append a row to timeseries.csv (the whole file rewritten atomically)."""
+        self.series.row(values)
+
+    @property
+    def next_index(self) -> int:
+        """The frame index after the last one written (or found when resuming)."""
+        return max(self._png_paths, default=self.frames_written - 1) + 1
+
+    def resume(self) -> None:
+        """Continue an existing output folder: keep its time series rows and frames."""
+        self.series.resume()
+        for p in sorted((self.out_dir / "frames").glob("frame_*.png")):
+            self._png_paths[int(p.stem.split("_")[1])] = p
+
+    # ----------------------------------------------------------------- frames
+
+    def frame(
+        self,
+        index: int,
+        t_s: float,
+        x_um: np.ndarray,
+        T_C: np.ndarray,
+        deform: np.ndarray,
+        liquid_fraction: np.ndarray,
+    ) -> None:
+        """Write frame ``index`` (PNG and/or VTU as configured) for time ``t_s`` seconds."""
+        x = np.asarray(x_um, dtype=float).reshape(-1, 2)
+        fields = {
+            "T_C": np.asarray(T_C, dtype=float).ravel(),
+            "deform": np.asarray(deform, dtype=float).ravel(),
+            "liquid_fraction": np.asarray(liquid_fraction, dtype=float).ravel(),
+        }
+        for name, v in fields.items():
+            if v.shape != (len(x),):
+                raise ValueError(f"frame {index}: {name} has {v.size} values for {len(x)} points")
+        index = int(index)
+        if self.png:
+            self._painter.draw(t_s, x, fields)
+            path = self.out_dir / "frames" / f"frame_{index:04d}.png"
+            self._painter.save(path, self.dpi)
+            self._png_paths[index] = path
+        if self.vtu:
+            self._vtu.write(index, float(t_s), x, fields)
+        self.frames_written += 1
+
+    # ----------------------------------------------------------------- end of run
+
+    def finish(self) -> None:
+        """Write animation.gif (if enabled) and timeseries.png; release the figure."""
+        self._painter.close()
+        if self.gif:
+            paths = [p for _, p in sorted(self._png_paths.items())]
+            if not paths:  # e.g. a fresh writer finishing an earlier run's folder
+                paths = sorted((self.out_dir / "frames").glob("frame_*.png"))
+            if paths:
+                write_gif(paths, self.out_dir / "animation.gif")
+        columns = [c for c in MONITORED if c in self.series.header]
+        plot_series(self.out_dir / "timeseries.csv", self.out_dir / "timeseries.png", columns)

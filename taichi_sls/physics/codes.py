@@ -1,0 +1,47 @@
+"""Named codes for the compile-time switches and the flags kept in fields."""
+
+from enum import IntEnum, IntFlag
+
+
+class Transfer(IntEnum):
+    """Grid-to-point velocity transfer (``solver.transfer``)."""
+
+    FLIP = 0  # eq. 14 as printed
+    PIC_FLIP = 1  # flip_ratio * FLIP + (1 - flip_ratio) * PIC
+    APIC = 2  # affine PIC
+
+
+class Update(IntEnum):
+    """When the stress is updated (``solver.update``)."""
+
+    USL = 0  # with the grid velocity v^{n+1} (eqs. 14-17)
+    MUSL = 1  # with the velocity remapped from the updated points
+
+
+class WallMechanical(IntEnum):
+    """Mechanical condition of a wall (``boundary.*.mechanical``)."""
+
+    SLIP = 0  # zero normal velocity
+    STICK = 1  # zero velocity
+    OPEN = 2  # no condition
+
+
+class ViscosityModel(IntEnum):
+    """``materials.*.viscosity_model``."""
+
+    EXPONENTIAL = 0  # eta = A exp(-b T[C]) (Table 3)
+    CONSTANT = 1
+
+
+class NodeFlag(IntFlag):
+    """Bits of the grid's ``flags`` field (the CSF method)."""
+
+    CURVATURE = 1  # the node's 9-point fit is a valid curvature
+    INTERFACE = 2  # the node carries a CSF force (mass and a mass gradient)
+
+
+class StressReading(IntEnum):
+    """``solver.stress_reading``."""
+
+    MODEL = 0  # s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md)
+    PAPER = 1  # eq. 39 and p = lambda tr(eps) as printed

@@ -1,0 +1,115 @@
+"""Strain split and the Perzyna elasto-viscoplastic return map (paper eqs. 34-45, MODEL.md).
+
+Plane strain: the in-plane total strain is accumulated from the velocity gradient
+(eqs. 16-17, eps_zz = 0); plastic, thermal and transformation strains are full 3x3 tensors.
+Readings of MODEL.md: s_trial = 2 mu dev(eps_e) (eq. 39 lost its 2 mu on the trace term) and
+p = K tr(eps_e), K = lambda + 2 mu / 3, with eps_e = eps - eps_pl - (eps_th + eps_m).
+"""
+
+import math
+
+import taichi as ti
+
+from .codes import StressReading
+from .materials import lerp_phase, viscosity
+
+SQRT23 = math.sqrt(2.0 / 3.0)
+
+
+@ti.func
+def embed3(e2):
+    """In-plane 2x2 strain -> 3x3 with eps_zz = 0 (plane strain)."""
+    e = ti.Matrix.zero(float, 3, 3)
+    for a, b in ti.static(ti.ndrange(2, 2)):
+        e[a, b] = e2[a, b]
+    return e
+
+
+@ti.func
+def moduli(mp: ti.template(), xi):
+    """(E, nu) of material ``mp`` at solid fraction xi: each interpolated in xi (MODEL.md)."""
+    E = lerp_phase(xi, mp.youngs_solid_Pa, mp.youngs_liquid_Pa)
+    nu = lerp_phase(xi, mp.poisson, mp.poisson_liquid)
+    return E, nu
+
+
+@ti.func
+def perzyna_update(
+    mp: ti.template(),
+    eps3,
+    eps_pl,
+    alpha,
+    e_iso,
+    xi,
+    T,
+    dt,
+    plastic: ti.template(),
+    reading: ti.template(),
+):
+    """One backward-Euler Perzyna step of material ``mp``. Returns (sigma, eps_pl, alpha).
+    ``reading``: MODEL.md's stress or the printed eq. 39 and pressure (StressReading).
+
+    Trial: s_tr = 2 mu dev(eps_e), f = |s_tr| - sqrt(2/3)(sigma_Y + H alpha) (eq. 40); when f > 0,
+    dgamma = (f / 2mu) / (tau/dt + 1 + H/(3 mu)), tau = eta / (2 mu) (eq. 41), and the plastic
+    strain, hardening variable and deviator follow eqs. 42-45.
+    """
+    E, nu = moduli(mp, xi)
+    mu = E / (2.0 * (1.0 + nu))
+    K = E / (3.0 * (1.0 - 2.0 * nu))
+    I3 = ti.Matrix.identity(float, 3)
+    ee = eps3 - eps_pl - e_iso * I3
+    tr = ee.trace()
+    s = 2.0 * mu * (ee - tr / 3.0 * I3)
+    p = K * tr
+    if ti.static(reading == StressReading.PAPER):
+        # eq. 39 as printed (the trace term without its 2 mu) and p = lambda tr(eps_{n+1})
+        s = 2.0 * mu * ee - tr / 3.0 * I3
+        p = (K - 2.0 * mu / 3.0) * eps3.trace()
+    if ti.static(plastic):
+        sy = lerp_phase(xi, mp.yield_solid_Pa, mp.yield_liquid_Pa)
+        Hh = lerp_phase(xi, mp.hardening_solid_Pa, mp.hardening_liquid_Pa)
+        snorm = s.norm()
+        f = snorm - SQRT23 * (sy + Hh * alpha)
+        if f > 0.0:
+            tau = viscosity(mp, T) / (2.0 * mu)
+            dgam = (f / (2.0 * mu)) / (tau / dt + 1.0 + Hh / (3.0 * mu))
+            n = s / snorm
+            eps_pl += dgam * n
+            alpha += SQRT23 * dgam
+            s -= 2.0 * mu * dgam * n
+    return p * I3 + s, eps_pl, alpha
+
+
+@ti.func
+def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
+    """Strain increment (eqs. 16-17, 34) and the Perzyna update (eqs. 38-45) of point p."""
+    eps = pt.strain[p] + 0.5 * (L + L.transpose()) * dt
+    pt.strain[p] = eps
+    sig, epl, a = perzyna_update(
+        mat[pt.material[p]],
+        embed3(eps),
+        pt.plastic_strain[p],
+        pt.equivalent_plastic_strain[p],
+        pt.iso_strain[p],
+        pt.solid_fraction[p],
+        pt.T[p],
+        dt,
+        cfg.plastic,
+        cfg.stress_reading,
+    )
+    pt.stress[p] = sig
+    pt.plastic_strain[p] = epl
+    pt.equivalent_plastic_strain[p] = a
+
+
+@ti.func
+def thermal_strain_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, dT, dxi):
+    """Eqs. 36-37 over one heat step (dT, d xi_s), alpha at the step's mean solid fraction. The
+    increment is spread over the heat_every mechanical steps that follow: added at once it is an
+    impulse that rings the elastic melt (the scan case's kinetic energy tripled with heat every
+    19 steps)."""
+    mp = mat[pt.material[p]]
+    alpha = lerp_phase(
+        pt.solid_fraction[p] - 0.5 * dxi, mp.expansion_solid_1_K, mp.expansion_liquid_1_K
+    )
+    pt.iso_strain_step[p] = (alpha * dT + mp.solidification_dilatation * dxi) / cfg.heat_every

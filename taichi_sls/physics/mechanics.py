@@ -1,0 +1,164 @@
+"""MPM mechanics: particle-to-grid, grid update, grid-to-particle (paper eqs. 10-18).
+
+Transfers (``solver.transfer``, :class:`~taichi_sls.physics.codes.Transfer`):
+- FLIP: eq. 14 as printed, v_p += sum N_i (v_i^{n+1} - v_i^n);
+- PIC_FLIP: r * FLIP + (1 - r) * PIC;
+- APIC: affine PIC (Jiang et al. 2015) with the uGIMP inertia D_p = sum N_ip (x_i - x_p)^2,
+  which is diagonal and position dependent for GIMP (between h^2/8 and h^2/4).
+Positions follow eq. 15 (the PIC grid velocity) in every variant.
+
+Update (``solver.update``): USL moves the points with the grid velocity v^{n+1} = v^n + dt f/m
+as eqs. 14-17 print it; MUSL (modified USL, Sulsky et al. 1995; Bardenhagen 2002) first updates
+the point velocities, maps their momenta back to the grid, and moves the points and computes L with
+that remapped velocity. On a node that a point barely touches, f/m is the stress term divided by a
+tiny mass and USL's velocity there is unbounded (a point that strays from the body is flung away);
+the remapped velocity is a weighted mean of point velocities and stays bounded. The remap also
+damps: a square of Maxwell fluid rounds off more slowly (tests/physics/test_mechanics.py), and it
+did not cure the fine-grid scan case's stray point (a filament climbing the left wall), so USL
+stays the default.
+
+``cfg`` is the step's compile-time configuration (grid geometry, switches); ``pt`` the points and
+``nd`` the nodes (struct fields, solver/fields.py).
+"""
+
+import taichi as ti
+
+from .codes import Transfer, WallMechanical
+from .grid import node_x
+from .shape import STENCIL, node_weight
+
+
+@ti.func
+def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
+    """Mass, momentum, internal force -V_p sigma_p grad N (eq. 11) and body force (eq. 12)."""
+    xp = pt.x[p]
+    mp = pt.mass[p]
+    vp = pt.v[p]
+    Vp = pt.volume0[p] * pt.J[p]
+    sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+        sig[a, b] = pt.stress[p][a, b]
+    g = ti.Vector(cfg.gravity, dt=float)
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        mv = vp
+        if ti.static(cfg.transfer == Transfer.APIC):
+            mv += pt.C[p] @ (node_x(cfg, I) - xp)
+        nd.mass[I] += N * mp
+        nd.momentum[I] += N * mp * mv
+        f = -Vp * (sig @ gN)
+        if ti.static(cfg.has_gravity):
+            f += N * mp * g
+        nd.force[I] += f
+
+
+@ti.func
+def apply_walls(cfg: ti.template(), I, v):
+    """Rigid walls on the node lines x = 0, x = W, y = 0, y = H and beyond (ghost nodes)."""
+    lo = cfg.off
+    hi = ti.Vector([cfg.off + cfg.ncx, cfg.off + cfg.ncy])
+    for d in ti.static(range(2)):
+        kind_lo = ti.static(cfg.wall_mechanical[2 * d])
+        kind_hi = ti.static(cfg.wall_mechanical[2 * d + 1])
+        if I[d] <= lo:
+            if ti.static(kind_lo == WallMechanical.SLIP):
+                v[d] = 0.0
+            elif ti.static(kind_lo == WallMechanical.STICK):
+                v = ti.Vector.zero(float, cfg.dim)
+        if I[d] >= hi[d]:
+            if ti.static(kind_hi == WallMechanical.SLIP):
+                v[d] = 0.0
+            elif ti.static(kind_hi == WallMechanical.STICK):
+                v = ti.Vector.zero(float, cfg.dim)
+    return v
+
+
+@ti.func
+def grid_velocity(cfg: ti.template(), nd: ti.template(), I, dt):
+    """v^n = (mv)/m and v^{n+1} = v^n + dt f / m (eqs. 10, 13); nodes below the cut-off rest."""
+    m = nd.mass[I]
+    vn = ti.Vector.zero(float, cfg.dim)
+    v = ti.Vector.zero(float, cfg.dim)
+    if m > cfg.mass_cut:
+        vn = nd.momentum[I] / m
+        v = apply_walls(cfg, I, vn + dt * nd.force[I] / m)
+    nd.v_old[I] = vn
+    nd.v[I] = v
+
+
+@ti.func
+def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
+    """The point velocity from the grid (transfer variant; eq. 14 for FLIP)."""
+    xp = pt.x[p]
+    v_pic = ti.Vector.zero(float, cfg.dim)
+    dv = ti.Vector.zero(float, cfg.dim)
+    B = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        vi = nd.v[I]
+        v_pic += N * vi
+        if ti.static(cfg.transfer == Transfer.APIC):
+            B += N * vi.outer_product(node_x(cfg, I) - xp)
+        else:
+            dv += N * (vi - nd.v_old[I])
+    if ti.static(cfg.transfer == Transfer.FLIP):
+        pt.v[p] += dv
+    elif ti.static(cfg.transfer == Transfer.PIC_FLIP):
+        r = ti.static(cfg.flip_ratio)
+        pt.v[p] = r * (pt.v[p] + dv) + (1.0 - r) * v_pic
+    else:
+        pt.v[p] = v_pic
+        # D_p per axis: sum_a w_a (x_a - x_p)^2 (uGIMP inertia), C = B D^-1
+        for d in ti.static(range(cfg.dim)):
+            Dd = 0.0
+            for a in ti.static(range(3)):
+                r = ti.cast(base[d] + a - cfg.off, float) * cfg.h - xp[d]
+                Dd += w[a, d] * r * r
+            for c in ti.static(range(cfg.dim)):
+                B[c, d] /= Dd
+        pt.C[p] = B
+
+
+@ti.func
+def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw, dt):
+    """Position (eq. 15), velocity gradient, F (eq. 17) and J (eq. 18) from the grid velocity.
+
+    Returns the velocity gradient L for the constitutive update.
+    """
+    v_grid = ti.Vector.zero(float, cfg.dim)
+    L = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        vi = nd.v[base + o]
+        v_grid += N * vi
+        L += vi.outer_product(gN)
+    pt.x[p] += dt * v_grid
+    F = (ti.Matrix.identity(float, cfg.dim) + dt * L) @ pt.F[p]
+    pt.F[p] = F
+    pt.J[p] = F.determinant()
+    return L
+
+
+@ti.func
+def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
+    """MUSL: the updated point momenta back to the grid (affine part included for APIC)."""
+    xp = pt.x[p]
+    mp = pt.mass[p]
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        mv = pt.v[p]
+        if ti.static(cfg.transfer == Transfer.APIC):
+            mv += pt.C[p] @ (node_x(cfg, I) - xp)
+        nd.momentum[I] += N * mp * mv
+
+
+@ti.func
+def grid_remap_velocity(cfg: ti.template(), nd: ti.template(), I):
+    """MUSL: the grid velocity from the remapped momenta, walls applied; empty nodes rest."""
+    v = ti.Vector.zero(float, cfg.dim)
+    if nd.mass[I] > cfg.mass_cut:
+        v = apply_walls(cfg, I, nd.momentum[I] / nd.mass[I])
+    nd.v[I] = v

@@ -1,0 +1,165 @@
+"""Heat conduction on the grid, enthalpy and solid fraction (eqs. 25-33).
+
+Per heat step: heat capacity c_i = sum M_p c_p N_ip (eq. 28, with c_p the apparent capacity
+dH/dT, so the grid update already sees the latent heat) and the capacity-weighted node
+temperature; the point temperature gradient grad T_p = sum T_i grad N_ip; the heat rate
+Q_i = - sum V_p k_p grad T_p . grad N_ip + sum V_p s_laser N_ip (eq. 29 with the weak-form minus
+sign of MODEL.md, eq. 30's laser term with eq. 31 read as W/m^3); dT_i = dt Q_i / c_i; each point
+gains enthalpy dH_p = c_p sum N_ip dT_i. Since sum_p M_p c_p N_ip / c_i = 1 this moves exactly the
+grid's heat to the points: the energy balance holds to round-off.
+
+Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
+increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
+to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
+(MODEL.md: resetting the nodes by increments drove points beside the plate to 110 C).
+
+Arguments: ``cfg`` the step's configuration, ``pt`` points, ``nd`` nodes, ``mat`` materials,
+``sc`` the run's scalars (laser energy, heat out, peak temperature), ``lasers`` the beams.
+"""
+
+import taichi as ti
+
+from .laser import laser_source
+from .materials import (
+    apparent_heat_capacity,
+    enthalpy,
+    lerp_phase,
+    solid_fraction,
+    temperature_from_enthalpy,
+)
+from .shape import STENCIL, node_weight
+
+
+@ti.func
+def p2g_heat_capacity(pt: ti.template(), nd: ti.template(), mat: ti.template(), p, base, w, dw):
+    mp = pt.mass[p]
+    c = apparent_heat_capacity(mat[pt.material[p]], pt.T[p])
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        nd.heat_capacity[I] += N * mp * c
+        nd.capacity_T[I] += N * mp * c * pt.T[p]
+
+
+@ti.func
+def fixed_temperature(cfg: ti.template(), I):
+    """(is fixed, wall temperature) of node I from the walls' thermal conditions."""
+    fixed = 0
+    Tw = 0.0
+    hi = ti.Vector([cfg.off + cfg.ncx, cfg.off + cfg.ncy])
+    for d in ti.static(range(2)):
+        if ti.static(cfg.wall_fixed[2 * d]):
+            if I[d] <= cfg.off:
+                fixed = 1
+                Tw = cfg.wall_T[2 * d]
+        if ti.static(cfg.wall_fixed[2 * d + 1]):
+            if I[d] >= hi[d]:
+                fixed = 1
+                Tw = cfg.wall_T[2 * d + 1]
+    return fixed, Tw
+
+
+@ti.func
+def grid_temperature(cfg: ti.template(), nd: ti.template(), I):
+    T = 0.0
+    if nd.heat_capacity[I] > 0.0:
+        T = nd.capacity_T[I] / nd.heat_capacity[I]
+        fixed, Tw = fixed_temperature(cfg, I)
+        if fixed:
+            T = Tw
+    nd.T[I] = T
+
+
+@ti.func
+def p2g_heat_flux(
+    cfg: ti.template(),
+    pt: ti.template(),
+    nd: ti.template(),
+    mat: ti.template(),
+    sc: ti.template(),
+    lasers: ti.template(),
+    p,
+    base,
+    w,
+    dw,
+    t,
+    dt,
+):
+    """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate."""
+    gT = ti.Vector.zero(float, cfg.dim)
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        gT += nd.T[base + o] * gN
+    mp = mat[pt.material[p]]
+    k = lerp_phase(pt.solid_fraction[p], mp.conductivity_solid_W_mK, mp.conductivity_liquid_W_mK)
+    Vp = pt.volume0[p] * pt.J[p]
+    s = 0.0
+    if ti.static(cfg.laser):
+        s = laser_source(lasers, cfg.n_lasers, pt.x[p], t, dt)
+        sc.laser_energy[None] += Vp * s * dt
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        nd.heat_rate[base + o] += -Vp * k * gT.dot(gN) + Vp * s * N
+
+
+@ti.func
+def grid_heat(cfg: ti.template(), nd: ti.template(), sc: ti.template(), I, dt):
+    dT = 0.0
+    if nd.heat_capacity[I] > 0.0:
+        fixed, Tw = fixed_temperature(cfg, I)
+        if fixed:
+            sc.heat_out[None] += dt * nd.heat_rate[I]
+        else:
+            dT = dt * nd.heat_rate[I] / nd.heat_capacity[I]
+    nd.dT[I] = dT
+
+
+@ti.func
+def g2p_heat(
+    cfg: ti.template(),
+    pt: ti.template(),
+    nd: ti.template(),
+    mat: ti.template(),
+    sc: ti.template(),
+    p,
+    base,
+    w,
+    dw,
+):
+    """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains.
+
+    Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
+    transfer). A point within the support of a fixed node takes the interpolated grid temperature
+    sum N T_i^{n+1} instead (T_i = the wall temperature there): a convex combination of node
+    temperatures, so it can never pass the wall temperature (MODEL.md), and second-order accurate
+    next to the wall where increments alone would lag. What that changes in its enthalpy beyond
+    the FLIP increment is heat exchanged with the wall and is booked in heat_out.
+    """
+    dTg = 0.0
+    T_pic = 0.0
+    w_fixed = 0.0
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        I = base + o
+        dTg += N * nd.dT[I]
+        if ti.static(cfg.any_fixed):
+            T_pic += N * (nd.T[I] + nd.dT[I])
+            fixed, Tw = fixed_temperature(cfg, I)
+            if fixed:
+                w_fixed += N
+    mp = mat[pt.material[p]]
+    T0 = pt.T[p]
+    xi0 = pt.solid_fraction[p]
+    dH = apparent_heat_capacity(mp, T0) * dTg
+    if ti.static(cfg.any_fixed):
+        if w_fixed > 0.0:
+            H_pic = enthalpy(mp, T_pic)
+            sc.heat_out[None] -= pt.mass[p] * (H_pic - pt.enthalpy[p] - dH)
+            dH = H_pic - pt.enthalpy[p]
+    pt.enthalpy[p] += dH
+    T1 = temperature_from_enthalpy(mp, pt.enthalpy[p])
+    xi1 = solid_fraction(mp, T1)
+    pt.T[p] = T1
+    pt.solid_fraction[p] = xi1
+    ti.atomic_max(sc.T_peak[None], T1)
+    return T1 - T0, xi1 - xi0

@@ -1,0 +1,223 @@
+"""The Taichi fields of one simulation: material points, grid nodes, the run's scalars, the
+parameter tables and the surface-tension scratch, each a named struct field.
+
+Points (``points``, one element per material point; SI):
+  x, x0 position now and at the start; v velocity; C APIC affine velocity; F deformation
+  gradient; J its determinant; strain the accumulated small strain (eqs. 16-17); plastic_strain
+  (3x3, plane strain); equivalent_plastic_strain (eq. 43); iso_strain the isotropic thermal and
+  transformation strain (eqs. 36-37) and iso_strain_step its increment per mechanical step;
+  stress (3x3); volume0; mass; material (index); enthalpy (J/kg); T (K); solid_fraction (eq. 33).
+Nodes (``nodes``, the grid of ``nx x ny``):
+  mass, momentum, force; v_old = v^n and v = v^{n+1}; heat_capacity (eq. 28), capacity_T
+  (sum c T), T, heat_rate (eqs. 29-30), dT; the CSF method's phi_raw (eq. 21), phi (signed
+  distance), phi_smooth, kappa, scratch, flags (NodeFlag bits) and mass_gradient (eq. 20).
+Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, laser_energy,
+  heat_out (heat through fixed-temperature walls), T_peak (running maximum), and for each of
+  WATCHED the first step at which a point showed it (NEVER if none), so that the guard, which
+  looks once per frame, can name what broke first.
+Totals (``totals``): the monitors' reductions over the points (solver/monitor.py).
+"""
+
+import numpy as np
+import taichi as ti
+
+from ..physics.constitutive import embed3, moduli, perzyna_update
+from ..physics.curvature import fit_matrix
+from ..physics.laser import laser_struct
+from ..physics.materials import KELVIN, enthalpy, material_struct, solid_fraction
+from .scene import Scene
+from .step_config import StepConfig
+
+# what the step watches at every point (solver/step.py, watch): a runaway temperature, an
+# inverted point, NaN; the first step at which each was seen is kept in the scalars
+WATCHED = ("hot", "inverted", "nan")
+NEVER = 2**31 - 1
+
+# reductions over the points, read once per output frame (solver/monitor.py)
+TOTALS = (
+    "T_max",
+    "mass_T",
+    "mass",
+    "molten_mass",
+    "enthalpy",
+    "kinetic_energy",
+    "J_min",
+    "J_max",
+    "T_min",
+    "v_max",
+    "trouble",  # a Trouble code: NaN, a point off the grid
+)
+
+
+POINT_MEMBERS = {
+    "x": "vector",
+    "x0": "vector",
+    "v": "vector",
+    "C": "matrix",
+    "F": "matrix",
+    "strain": "matrix",
+    "plastic_strain": "matrix3",
+    "equivalent_plastic_strain": "scalar",
+    "iso_strain": "scalar",
+    "iso_strain_step": "scalar",
+    "stress": "matrix3",
+    "volume0": "scalar",
+    "J": "scalar",
+    "mass": "scalar",
+    "material": "index",
+    "enthalpy": "scalar",
+    "T": "scalar",
+    "solid_fraction": "scalar",
+}
+NODE_MEMBERS = {
+    "mass": "scalar",
+    "momentum": "vector",
+    "force": "vector",
+    "v_old": "vector",
+    "v": "vector",
+    "heat_capacity": "scalar",
+    "capacity_T": "scalar",
+    "T": "scalar",
+    "heat_rate": "scalar",
+    "dT": "scalar",
+    "phi_raw": "scalar",
+    "phi": "scalar",
+    "phi_smooth": "scalar",
+    "kappa": "scalar",
+    "scratch": "scalar",
+    "flags": "index",
+    "mass_gradient": "vector",
+}
+
+
+def struct_type(members: dict[str, str], dim: int):
+    """A Taichi struct type from member kinds (after ti.init: ``float`` is the precision)."""
+    kinds = {
+        "scalar": float,
+        "index": ti.i32,
+        "vector": ti.types.vector(dim, float),
+        "matrix": ti.types.matrix(dim, dim, float),
+        "matrix3": ti.types.matrix(3, 3, float),
+    }
+    return ti.types.struct(**{k: kinds[v] for k, v in members.items()})
+
+
+@ti.data_oriented
+class SurfaceScratch:
+    """Per-rebuild data of the CSF method: contour segments (up to two per cell, end points in
+    metres), the list of interface nodes, the eq. 23 fit matrix and the force resultant."""
+
+    def __init__(self, nx: int, ny: int) -> None:
+        self.ends = ti.Vector.field(8, float, (nx - 1, ny - 1))
+        self.count = ti.field(ti.i32, (nx - 1, ny - 1))
+        self.iface = ti.Vector.field(2, ti.i32, nx * ny)
+        self.n_iface = ti.field(ti.i32, ())
+        self.fit = ti.Matrix.field(6, 9, float, ())
+        self.resultant = ti.Vector.field(3, float, ())  # force x, y and interface mass
+
+
+@ti.data_oriented
+class State:
+    """Every field of a run; ``cfg`` (StepConfig) is the compile-time configuration."""
+
+    def __init__(
+        self,
+        cfg: StepConfig,
+        scene: Scene,
+        materials: dict[str, np.ndarray],
+        lasers: dict[str, np.ndarray],
+    ) -> None:
+        self.cfg = cfg
+        self.scene = scene
+        self.points = struct_type(POINT_MEMBERS, cfg.dim).field(
+            shape=scene.n_points, layout=ti.Layout.SOA
+        )
+        self.nodes = struct_type(NODE_MEMBERS, cfg.dim).field(
+            shape=(cfg.nx, cfg.ny), layout=ti.Layout.SOA
+        )
+        self.scalars = ti.types.struct(
+            t=float,
+            step=ti.i32,
+            dt=float,
+            laser_energy=float,
+            heat_out=float,
+            T_peak=float,
+            **{f"first_{k}": ti.i32 for k in WATCHED},
+        ).field(shape=())
+        n_mat = len(scene.material_names)
+        self.materials = material_struct().field(shape=n_mat, layout=ti.Layout.SOA)
+        self.lasers = laser_struct().field(shape=max(cfg.n_lasers, 1), layout=ti.Layout.SOA)
+        self.surf = SurfaceScratch(cfg.nx, cfg.ny)
+        self.box = ti.Vector.field(4, ti.i32, ())  # active region [i0, j0, i1, j1)
+        self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())
+        self._fill(materials, lasers)
+
+    @property
+    def n_points(self) -> int:
+        return self.cfg.n_points
+
+    def _fill(self, materials: dict[str, np.ndarray], lasers: dict[str, np.ndarray]) -> None:
+        cfg, sc = self.cfg, self.scene
+        self.materials.from_numpy(materials)
+        rho = materials["density_kg_m3"][sc.material]
+        pt = ti.static(self.points)
+        pt.x.from_numpy(sc.x)
+        pt.x0.from_numpy(sc.x)
+        pt.v.from_numpy(sc.v0)
+        pt.volume0.from_numpy(sc.vol)
+        pt.mass.from_numpy(sc.vol * rho)
+        pt.material.from_numpy(sc.material)
+        pt.T.from_numpy(sc.T0_C + KELVIN)
+        self.surf.fit[None] = fit_matrix()
+        # outside the active region the grid keeps these: empty, and outside every body
+        for f in (self.nodes.phi_raw, self.nodes.phi, self.nodes.phi_smooth):
+            f.fill(cfg.phi_cap)
+        full = [0, 0, cfg.nx, cfg.ny]
+        self.box[None] = [cfg.nx, cfg.ny, 0, 0] if cfg.active_region else full
+        if cfg.n_lasers:
+            self.lasers.from_numpy(lasers)
+        self.scalars.t[None] = 0.0
+        self.scalars.T_peak[None] = float(np.max(sc.T0_C + KELVIN))
+        for k in WATCHED:
+            getattr(self.scalars, f"first_{k}")[None] = NEVER
+        self._init_points()
+        if np.any(sc.p0 != 0.0):
+            self._prestress(sc.p0)
+
+    @ti.kernel
+    def _init_points(self):
+        pt = ti.static(self.points)
+        for p in range(self.cfg.n_points):
+            pt.F[p] = ti.Matrix.identity(float, self.cfg.dim)
+            pt.J[p] = 1.0
+            pt.C[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
+            pt.strain[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
+            pt.plastic_strain[p] = ti.Matrix.zero(float, 3, 3)
+            pt.stress[p] = ti.Matrix.zero(float, 3, 3)
+            pt.equivalent_plastic_strain[p] = 0.0
+            pt.iso_strain[p] = 0.0
+            pt.iso_strain_step[p] = 0.0
+            pt.enthalpy[p] = enthalpy(self.materials[pt.material[p]], pt.T[p])
+            pt.solid_fraction[p] = solid_fraction(self.materials[pt.material[p]], pt.T[p])
+
+    @ti.kernel
+    def _prestress(self, p0: ti.types.ndarray()):
+        """The elastic strain that carries an in-plane pressure p0 (plane strain, eps_zz = 0:
+        eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at each point's initial moduli, and its stress
+        under the case's stress reading."""
+        pt = ti.static(self.points)
+        for p in range(self.cfg.n_points):
+            if p0[p] != 0.0:
+                mp = self.materials[pt.material[p]]
+                xi = pt.solid_fraction[p]
+                E, nu = moduli(mp, xi)
+                lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
+                eps = ti.Matrix.identity(float, self.cfg.dim) * (-p0[p] / (2.0 * lam_mu))
+                pt.strain[p] = eps
+                z = ti.Matrix.zero(float, 3, 3)
+                pt.stress[p] = perzyna_update(
+                    mp, embed3(eps), z, 0.0, 0.0, xi, pt.T[p], 1.0, False, self.cfg.stress_reading
+                )[0]
+
+    def node_position(self, i: int, j: int) -> tuple[float, float]:
+        return ((i - self.cfg.off) * self.cfg.h, (j - self.cfg.off) * self.cfg.h)

@@ -1,0 +1,106 @@
+"""Case tables -> the parameter structs of the kernels, and the stability limits (eqs. 46-48).
+
+Material members keep the case's key names; a key in C becomes the same name in K
+(physics/materials.py). Laser members are in SI, ``_um`` keys becoming ``_m``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..config import Case, Material
+from ..physics.codes import ViscosityModel
+from ..physics.laser import LASER_MEMBERS
+from ..physics.materials import KELVIN, MATERIAL_MEMBERS
+
+# the material keys that are temperatures (C), kept in kelvin under the same name with _K
+TEMPERATURES_C = ("melt_C", "crystallization_C")
+
+
+def material_values(m: Material, enthalpy_reference_C: float) -> dict[str, float]:
+    """The kernel's parameters of one material (SI, temperatures in K)."""
+    vals: dict[str, float] = {}
+    for key, v in m.model_dump().items():
+        if key in TEMPERATURES_C:
+            vals[key[:-2] + "_K"] = v + KELVIN
+        elif key == "viscosity_model":
+            vals[key] = int(ViscosityModel[v.upper()])
+        else:
+            vals[key] = v
+    T_c, T_m = vals["crystallization_K"], vals["melt_K"]
+    T_ref = enthalpy_reference_C + KELVIN
+    H_c = m.heat_capacity_solid_J_kgK * (T_c - T_ref)
+    # mushy sensible heat with c linear in T from c_c to c_m, plus the whole latent heat
+    H_m = H_c + 0.5 * (m.heat_capacity_solid_J_kgK + m.heat_capacity_liquid_J_kgK) * (T_m - T_c)
+    H_m += m.latent_heat_J_kg
+    vals.update(
+        enthalpy_reference_K=T_ref, enthalpy_crystallization_J_kg=H_c, enthalpy_melt_J_kg=H_m
+    )
+    return {k: vals[k] for k in MATERIAL_MEMBERS}
+
+
+def material_arrays(case: Case, names: list[str]) -> dict[str, np.ndarray]:
+    """Every material's parameters, one array per struct member (for ``from_numpy``)."""
+    rows = [material_values(case.materials[n], case.thermal.enthalpy_reference_C) for n in names]
+    return {
+        k: np.array([r[k] for r in rows], dtype=np.int32 if k == "viscosity_model" else float)
+        for k in MATERIAL_MEMBERS
+    }
+
+
+def laser_arrays(case: Case) -> dict[str, np.ndarray]:
+    """Every beam's parameters in SI, one array per struct member."""
+    top = case.top_um()
+    rows = []
+    for las in case.lasers:
+        r0 = las.spot_radius_um * 1e-6
+        eta = las.penetration_depth_um * 1e-6
+        # eq. 31 read as power per unit volume (W/m^3), MODEL.md
+        amp = 2 * las.absorptivity * las.power_W / (math.pi * r0 * r0 * eta) * las.depth_factor
+        if las.source_units == "W_per_kg":  # eq. 3 as printed: rho * s_laser
+            amp *= case.materials[case.bodies[0].material].density_kg_m3
+        x_end = las.x_end_um if las.x_end_um is not None else 1e9
+        y_top = las.top_um if las.top_um is not None else top
+        rows.append(
+            dict(
+                on_s=las.on_s,
+                off_s=las.off_s,
+                x_start_m=las.x_start_um * 1e-6,
+                speed_m_s=las.speed_m_s,
+                x_end_m=x_end * 1e-6,
+                top_m=y_top * 1e-6,
+                amplitude_W_m3=amp,
+                spot_radius_m=r0,
+                penetration_depth_m=eta,
+                depth_sign=1.0 if las.depth_sign == "decay" else -1.0,
+            )
+        )
+    return {k: np.array([r[k] for r in rows], dtype=float) for k in LASER_MEMBERS}
+
+
+# ----------------------------------------------------------------------------- stability
+
+
+def p_wave_modulus(E: float, nu: float) -> float:
+    """M = E (1 - nu) / ((1 + nu)(1 - 2 nu)): the modulus of the fastest (dilatational) wave."""
+    return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+
+
+def stability_limits(m: Material, h: float) -> dict[str, float]:
+    """Time-step limits (s) of one material on grid spacing h (m), MODEL.md / eqs. 46-48.
+
+    The elastic limit uses the larger P-wave modulus of the two phases, each with its own nu;
+    the thermal limit the smallest heat capacity and largest conductivity.
+    """
+    M = max(
+        p_wave_modulus(m.youngs_solid_Pa, m.poisson),
+        p_wave_modulus(m.youngs_liquid_Pa, m.poisson_liquid),
+    )
+    c_wave = math.sqrt(M / m.density_kg_m3)
+    k = max(m.conductivity_solid_W_mK, m.conductivity_liquid_W_mK)
+    c = min(m.heat_capacity_solid_J_kgK, m.heat_capacity_liquid_J_kgK)
+    out = {"elastic": h / c_wave, "thermal": h * h * m.density_kg_m3 * c / (4 * k)}
+    if m.surface_tension_N_m > 0:
+        out["surface_tension"] = math.sqrt(m.density_kg_m3 * h**3 / m.surface_tension_N_m)
+    return out

@@ -1,0 +1,142 @@
+"""Bodies -> material points, and the grid that holds them (paper section 3.1, Table 1).
+
+Points are seeded ``n x n`` per cell at the cell's regular sub-positions (2x2: the quarter points)
+and kept where they lie inside a body. The grid covers the domain plus ``ghost_cells`` beyond the
+left, right and bottom walls (the surface-tension stencil of section 3.1) plus a margin of
+``PAD`` cells on every side so that no stencil ever leaves the arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import Case, CaseError
+
+PAD = 2  # cells of array margin beyond the ghost layer
+
+
+@dataclass
+class Scene:
+    h: float  # grid spacing (m)
+    nx: int  # nodes along x in the arrays
+    ny: int
+    off: int  # array index of the node at x = 0 (and y = 0)
+    width: float  # domain (m)
+    height: float
+    x: np.ndarray  # (N, 2) point positions (m)
+    vol: np.ndarray  # (N,) point volumes (m^2 per unit depth)
+    body: np.ndarray  # (N,) body index
+    material: np.ndarray  # (N,) material index
+    T0_C: np.ndarray  # (N,) initial temperature (C)
+    v0: np.ndarray  # (N, 2) initial velocity (m/s)
+    p0: np.ndarray  # (N,) initial in-plane pressure (Pa): surface_tension.initial_stress
+    material_names: list[str]
+    table1_nodes: int  # nodes of domain plus ghost layer (what the paper's Table 1 counts)
+
+    @property
+    def n_points(self) -> int:
+        return len(self.x)
+
+    def reordered(self, order: np.ndarray) -> Scene:
+        """The same points in another order (the speed benchmark shuffles them)."""
+        per_point = ("x", "vol", "body", "material", "T0_C", "v0", "p0")
+        return Scene(**{**vars(self), **{k: getattr(self, k)[order] for k in per_point}})
+
+
+def inside_polygon(vertices: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """Even-odd rule: which of the points (px, py) lie inside the closed outline."""
+    inside = np.zeros(px.shape, dtype=bool)
+    xa, ya = vertices[:, 0], vertices[:, 1]
+    xb, yb = np.roll(xa, -1), np.roll(ya, -1)
+    for x0, y0, x1, y1 in zip(xa, ya, xb, yb, strict=True):
+        crosses = (y0 > py) != (y1 > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_at = x0 + (py - y0) * (x1 - x0) / (y1 - y0)
+        inside ^= crosses & (px < x_at)
+    return inside
+
+
+def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    if body.shape == "disc":
+        cx, cy = body.center_um
+        dx, dy = px - cx, py - cy
+        # r < R (1 + eps cos n theta): a shape mode of the disc (eps = 0: the plain disc)
+        r = body.radius_um * (1.0 + body.perturbation * np.cos(body.mode * np.arctan2(dy, dx)))
+        return dx**2 + dy**2 < r**2
+    if body.shape == "polygon":
+        return inside_polygon(np.asarray(body.outline_um(), dtype=float), px, py)
+    (x0, y0), (x1, y1) = body.min_um, body.max_um
+    return (px > x0) & (px < x1) & (py > y0) & (py < y1)
+
+
+def laplace_pressure(case: Case, body) -> float:
+    """Initial in-plane pressure of a body (Pa): gamma/R for a disc (Young-Laplace in 2D) with
+    ``surface_tension.initial_stress = "laplace"`` and surface tension on, else 0. A powder
+    particle at the preheat temperature has long been in equilibrium with its surface tension;
+    started stress-free, the soft discs are compressed by it at t = 0, which opens the neck
+    (docs/model.md: the nolaser case)."""
+    ph = case.physics
+    if (
+        case.surface_tension.initial_stress != "laplace"
+        or not (ph.surface_tension and ph.mechanics)
+        or body.shape != "disc"
+    ):
+        return 0.0
+    return case.materials[body.material].surface_tension_N_m / (body.radius_um * 1e-6)
+
+
+def build_scene(case: Case) -> Scene:
+    """Seed the points of every body (a point belongs to the first body that holds it)."""
+    h_um = case.grid.spacing_um
+    W, H = case.domain.width_um, case.domain.height_um
+    ncx = int(round(W / h_um))
+    ncy = int(round(H / h_um))
+    n = case.grid.points_per_cell
+    sub = (np.arange(n) + 0.5) / n  # 2 per cell -> 1/4, 3/4: the quarter points
+    gx = ((np.arange(ncx)[:, None] + sub[None, :]) * h_um).ravel()
+    gy = ((np.arange(ncy)[:, None] + sub[None, :]) * h_um).ravel()
+    PX, PY = np.meshgrid(gx, gy, indexing="ij")
+    PX, PY = PX.ravel(), PY.ravel()
+    taken = np.zeros(PX.shape, dtype=bool)
+    names = list(case.materials)
+    xs, bodies, mats, temps, vels, pres = [], [], [], [], [], []
+    for bi, b in enumerate(case.bodies):
+        sel = _inside(b, PX, PY) & ~taken
+        taken |= sel
+        k = int(sel.sum())
+        if k == 0:
+            raise CaseError(
+                f"bodies[{bi}]: holds no material point at grid.spacing_um = {h_um} "
+                f"({case.grid.points_per_cell}x{case.grid.points_per_cell} per cell); make it "
+                "larger or the grid finer"
+            )
+        xs.append(np.stack([PX[sel], PY[sel]], axis=1))
+        bodies.append(np.full(k, bi, dtype=np.int32))
+        mats.append(np.full(k, names.index(b.material), dtype=np.int32))
+        T = case.thermal.initial_C if b.temperature_C is None else b.temperature_C
+        temps.append(np.full(k, T))
+        vels.append(np.tile(np.asarray(b.velocity_m_s, dtype=float), (k, 1)))
+        pres.append(np.full(k, laplace_pressure(case, b)))
+    x = np.concatenate(xs) * 1e-6
+    g = case.grid.ghost_cells
+    off = g + PAD
+    h = h_um * 1e-6
+    return Scene(
+        h=h,
+        nx=ncx + 1 + 2 * off,
+        ny=ncy + 1 + 2 * off,
+        off=off,
+        width=W * 1e-6,
+        height=H * 1e-6,
+        x=x,
+        vol=np.full(len(x), (h / n) ** 2),
+        body=np.concatenate(bodies),
+        material=np.concatenate(mats),
+        T0_C=np.concatenate(temps),
+        v0=np.concatenate(vels),
+        p0=np.concatenate(pres),
+        material_names=names,
+        table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g),
+    )

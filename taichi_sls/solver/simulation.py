@@ -1,0 +1,187 @@
+"""A simulation: Taichi set-up, time step, stepping, monitors and snapshots of one case."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import taichi as ti
+
+from ..config import Case
+from ..physics.materials import KELVIN
+from . import checkpoint
+from .fields import State
+from .guard import Guard
+from .monitor import body_centroids_x, neck_measures, point_monitors
+from .params import laser_arrays, material_arrays
+from .scene import Scene, build_scene
+from .step import advance, level_set_only
+from .step_config import step_config
+from .time_step import resolve_curvature_every, resolve_dt, resolve_heat_every
+
+
+def init_taichi(
+    arch: str = "cpu", precision: str = "f64", optimize: bool = False, fast_math: bool = True
+) -> None:
+    """(Re)initialise Taichi. Re-initialising frees every field, so one Simulation is live at a
+    time. ``optimize=False`` skips Taichi's advanced IR optimisation: the fused step compiles in
+    seconds instead of about 100 s and runs about 1.1-1.5x slower. ``fast_math=False``: strict
+    IEEE arithmetic (the compiler may not reorder sums), so that a change of code structure that
+    keeps every formula keeps every result bit for bit."""
+    ti.init(
+        arch=ti.cpu if arch == "cpu" else ti.gpu,
+        default_fp=ti.f64 if precision == "f64" else ti.f32,
+        offline_cache=True,
+        advanced_optimization=optimize,
+        fast_math=fast_math,
+        log_level=ti.ERROR,
+    )
+
+
+class Simulation:
+    """One case on the device: ``advance(n)`` steps, ``monitors()`` reads (and guards) the
+    state, ``snapshot()`` gives the points for output.
+
+    ``scene``: the points to use instead of seeding the case's bodies (studies set initial
+    fields through it; the speed benchmark passes them shuffled). ``before_step``: called with
+    the simulation before every step (a study's time-dependent load); stepping then goes one
+    step per kernel call."""
+
+    def __init__(
+        self,
+        case: Case,
+        *,
+        init: bool = True,
+        scene: Scene | None = None,
+        before_step: Callable[[Simulation], None] | None = None,
+    ) -> None:
+        if init:
+            sv = case.solver
+            init_taichi(sv.arch, sv.precision, sv.optimize, sv.fast_math)
+        self.case = case
+        self.before_step = before_step
+        self.dt, self.dt_limits = resolve_dt(case)
+        self.heat_every = resolve_heat_every(case, self.dt, self.dt_limits)
+        self.curvature_every = resolve_curvature_every(case, self.dt, self.dt_limits)
+        self.scene: Scene = build_scene(case) if scene is None else scene
+        cfg = step_config(case, self.scene, self.heat_every, self.curvature_every)
+        mats = material_arrays(case, self.scene.material_names)
+        self.state = State(cfg, self.scene, mats, laser_arrays(case))
+        self.state.scalars.dt[None] = self.dt
+        self.steps = 0
+        t0 = time.perf_counter()
+        advance(self.state, 0)  # compiles the step kernel
+        self.compile_s = time.perf_counter() - t0
+        self._mass = self.state.points.mass.to_numpy()
+        walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
+        coldest = min([float(self.scene.T0_C.min()), *walls])
+        # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32
+        self.guard = Guard(
+            self.state,
+            self.dt,
+            self.dt_limits,
+            T_floor_K=coldest + KELVIN if case.physics.thermal else -math.inf,
+            energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
+        )
+        self._pair = len(case.bodies) >= 2
+        self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
+        self._e_static: float | None = None  # the step-independent part of energy_bound
+
+    @property
+    def t(self) -> float:
+        return float(self.state.scalars.t[None])
+
+    def advance(self, n: int) -> None:
+        """Advance n steps."""
+        if n <= 0:
+            return
+        if self.before_step is not None:
+            for _ in range(n):
+                self.before_step(self)
+                advance(self.state, 1)
+        else:
+            advance(self.state, n)
+        self.steps += n
+
+    # ------------------------------------------------------------------ monitors
+    def phi(self) -> np.ndarray:
+        """Level set of eq. 21 on the nodes (m) of the current points."""
+        level_set_only(self.state)
+        return self.state.nodes.phi.to_numpy()
+
+    def contact_line_m(self) -> tuple[float, float]:
+        """(contact line, neck span) in metres; see :mod:`taichi_sls.solver.monitor`."""
+        if not self._pair:
+            return float("nan"), float("nan")
+        x = self.state.points.x.to_numpy()
+        cx = body_centroids_x(x, self.scene.body, self._mass)
+        lo, hi = sorted(cx[:2])
+        cfg = self.state.cfg
+        return neck_measures(self.phi(), cfg.h, cfg.off, lo, hi)
+
+    def monitors(self, guard: bool = True) -> dict[str, float]:
+        """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard unless
+        ``guard`` is false (the last state of a failed run)."""
+        st = self.state
+        out = {"t_s": self.t, "step": float(self.steps)}
+        public, internal = point_monitors(st)
+        out.update(public)
+        out["T_peak_C"] = float(st.scalars.T_peak[None] - KELVIN)
+        out["laser_energy_J_per_m"] = float(st.scalars.laser_energy[None])
+        out["heat_out_J_per_m"] = float(st.scalars.heat_out[None])
+        cl, span = self.contact_line_m()
+        out["contact_line_um"] = cl * 1e6
+        out["neck_span_um"] = span * 1e6
+        if self.steps == 0 and self._H0 is None:
+            self._H0 = out["enthalpy_J_per_m"]
+        if guard:
+            self.guard.check(
+                out, internal, self.steps, self.t, self.energy_error(out), self.energy_bound()
+            )
+        return out
+
+    def energy_error(self, mon: dict[str, float]) -> float:
+        """(laser - heat out - enthalpy rise) / (initial enthalpy + laser): 0 up to round-off."""
+        if self._H0 is None:
+            return 0.0
+        rise = mon["enthalpy_J_per_m"] - self._H0
+        net = mon["laser_energy_J_per_m"] - mon["heat_out_J_per_m"]
+        return (net - rise) / (abs(self._H0) + mon["laser_energy_J_per_m"])
+
+    def energy_bound(self) -> float:
+        """Every energy a run can turn into motion: initial kinetic energy, surface energy of the
+        bodies' outlines, potential energy across the domain, laser energy so far (J/m)."""
+        if self._e_static is None:
+            c = self.case
+            gamma = max(m.surface_tension_N_m for m in c.materials.values())
+            g = math.hypot(*c.physics.gravity_m_s2)
+            M = float(self._mass.sum())
+            v0 = self.state.points.v.to_numpy()
+            ke0 = 0.5 * float((self._mass * (v0**2).sum(axis=1)).sum())
+            self._e_static = ke0 + gamma * c.perimeter_um() * 1e-6 + M * g * self.scene.height
+        return self._e_static + float(self.state.scalars.laser_energy[None])
+
+    # ------------------------------------------------------------------ state
+    def save_checkpoint(self, path: Path, extra: dict | None = None) -> None:
+        """The full state, written atomically; ``extra`` (numbers) alongside, e.g. the frame."""
+        checkpoint.save(self.state, path, self.steps, self.case.case.name, extra)
+
+    def load_checkpoint(self, path: Path) -> dict:
+        """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``."""
+        self.steps, extra = checkpoint.load(self.state, path, self.case.case.name)
+        self.dt = float(self.state.scalars.dt[None])
+        return extra
+
+    def snapshot(self) -> dict[str, np.ndarray]:
+        pt = self.state.points
+        x = pt.x.to_numpy()
+        return {
+            "x_um": x * 1e6,
+            "T_C": pt.T.to_numpy() - KELVIN,
+            "displacement_um": np.linalg.norm(x - pt.x0.to_numpy(), axis=1) * 1e6,
+            "plastic_strain": pt.equivalent_plastic_strain.to_numpy(),
+            "liquid_fraction": 1.0 - pt.solid_fraction.to_numpy(),
+        }

@@ -1,0 +1,323 @@
+"""One explicit MPM step (update-stress-last) as an ordered list of stages, and its layouts.
+
+    active_region  grows to hold every point plus margins; grid loops run over it only
+    clear_grid
+    p2g            mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; eq. 21**
+    grid_prepare   v^n; node temperature (fixed-temperature walls)*
+    surface_force  level set and curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
+    heat_flux      grad T_p, conduction and laser heat rates (eqs. 29-31)*
+    grid_update    v^{n+1} with walls (eq. 13); dT_i*
+    g2p            velocity, position, L, F, J (eqs. 14-18); enthalpy, T, xi_s (eqs. 32-33)*;
+                   strain split and Perzyna return map (eqs. 34-45)
+    advance_clock  t += dt
+
+``STAGES`` writes this order once; every layout and the diagnostic kernels run it (or a prefix
+of it). Two clocks skip what a step does not need. * Heat runs every ``heat_every`` steps with a
+heat step of heat_every * dt: conduction's stability limit is ~100x the elastic one, and its
+thermal strain increment is spread over the mechanical steps that follow. ** The level set and
+curvature are rebuilt every ``curvature_every`` steps (a fraction of the capillary limit); the
+CSF force is rebuilt from the current mass every step. Each stage takes ``heat`` and ``geom``:
+Python bools in the parallel layout (the stages compile in or out), runtime flags in the serial
+one.
+
+Layouts. Serial (CPU, small scenes): many steps inside one kernel call with the step loop
+serialized, since a kernel launch costs tens of microseconds and the paper's scene has a few
+thousand points. Parallel (GPU, large scenes): one kernel call per step, every stage a parallel
+loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
+"""
+
+import taichi as ti
+
+from ..physics.codes import Update
+from ..physics.constitutive import stress_update, thermal_strain_step
+from ..physics.csf import csf_force, mass_gradient, surface_geometry
+from ..physics.grid import active
+from ..physics.level_set import level_set, scatter_level_set
+from ..physics.mechanics import (
+    g2p_kinematics,
+    g2p_velocity,
+    grid_remap_velocity,
+    grid_velocity,
+    p2g_mechanics,
+    p2g_momentum,
+)
+from ..physics.shape import stencil
+from ..physics.thermal import (
+    g2p_heat,
+    grid_heat,
+    grid_temperature,
+    p2g_heat_capacity,
+    p2g_heat_flux,
+)
+from .fields import State
+
+
+@ti.func
+def point_stencil(cfg: ti.template(), pt: ti.template(), p):
+    base, w, dw = stencil(pt.x[p], cfg.inv_h, cfg.h, cfg.lp, cfg.off)
+    # A point that has left the grid (or become NaN) must not write outside the arrays: clamp
+    # its stencil; the guard reports it at the next frame. The 2-cell padding keeps every point
+    # of a healthy run far from this bound.
+    base = ti.max(ti.min(base, ti.Vector([cfg.nx - 4, cfg.ny - 4])), 1)
+    return base, w, dw
+
+
+@ti.func
+def active_region(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """Grow the active region to hold every point's level-set footprint (5x5 nodes) plus
+    ``box_margin`` nodes; grid loops run over it only. It never shrinks, so no node outside it
+    has ever been written: there every field keeps its empty initial value."""
+    if ti.static(st.cfg.active_region):
+        m = ti.static(st.cfg.box_margin)
+        for p in range(st.cfg.n_points):
+            base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
+            ti.atomic_min(st.box[None][0], ti.max(base[0] - 1 - m, 0))
+            ti.atomic_min(st.box[None][1], ti.max(base[1] - 1 - m, 0))
+            ti.atomic_max(st.box[None][2], ti.min(base[0] + 4 + m, st.cfg.nx))
+            ti.atomic_max(st.box[None][3], ti.min(base[1] + 4 + m, st.cfg.ny))
+
+
+@ti.func
+def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    nd = ti.static(st.nodes)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        nd.mass[I] = 0.0
+        nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
+        nd.force[I] = ti.Vector.zero(float, st.cfg.dim)
+        if ti.static(st.cfg.thermal):
+            if heat:
+                nd.heat_capacity[I] = 0.0
+                nd.capacity_T[I] = 0.0
+                nd.heat_rate[I] = 0.0
+        if ti.static(st.cfg.surface):
+            if geom:
+                nd.phi_raw[I] = st.cfg.phi_cap
+
+
+@ti.func
+def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    pt, nd = ti.static(st.points, st.nodes)
+    for p in range(st.cfg.n_points):
+        base, w, dw = point_stencil(st.cfg, pt, p)
+        if ti.static(st.cfg.mech):
+            p2g_mechanics(st.cfg, pt, nd, p, base, w, dw)
+        if ti.static(st.cfg.thermal):
+            if heat:
+                p2g_heat_capacity(pt, nd, st.materials, p, base, w, dw)
+        if ti.static(st.cfg.surface):
+            if geom:
+                scatter_level_set(st.cfg, pt, nd, p, base)
+
+
+@ti.func
+def grid_prepare(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        if ti.static(st.cfg.mech):
+            grid_velocity(st.cfg, st.nodes, I, 0.0)  # v^n only; forces are not complete yet
+        if ti.static(st.cfg.thermal):
+            if heat:
+                grid_temperature(st.cfg, st.nodes, I)
+
+
+@ti.func
+def surface_force(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    if ti.static(st.cfg.surface):
+        if ti.static(isinstance(geom, bool)):
+            if ti.static(geom):
+                surface_geometry(st.cfg, st.box, st.nodes, st.surf)
+            else:
+                mass_gradient(st.cfg, st.box, st.nodes)
+        else:
+            if geom:
+                surface_geometry(st.cfg, st.box, st.nodes, st.surf)
+            else:
+                mass_gradient(st.cfg, st.box, st.nodes)
+        csf_force(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.func
+def _heat_flux_loop(st: ti.template()):
+    dt_heat = st.scalars.dt[None] * st.cfg.heat_every
+    t = st.scalars.t[None]
+    pt = ti.static(st.points)
+    for p in range(st.cfg.n_points):
+        base, w, dw = point_stencil(st.cfg, pt, p)
+        p2g_heat_flux(
+            st.cfg, pt, st.nodes, st.materials, st.scalars, st.lasers, p, base, w, dw, t, dt_heat
+        )
+
+
+@ti.func
+def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    if ti.static(st.cfg.thermal):
+        if ti.static(isinstance(heat, bool)):
+            if ti.static(heat):
+                _heat_flux_loop(st)
+        else:
+            if heat:
+                _heat_flux_loop(st)
+
+
+@ti.func
+def grid_update(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    dt = st.scalars.dt[None]
+    dt_heat = dt * st.cfg.heat_every
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        if ti.static(st.cfg.mech):
+            grid_velocity(st.cfg, st.nodes, I, dt)
+        if ti.static(st.cfg.thermal):
+            if heat:
+                grid_heat(st.cfg, st.nodes, st.scalars, I, dt_heat)
+
+
+@ti.func
+def g2p_point(
+    st: ti.template(), p, base, w, dw, dt, kinematics: ti.template(), heat: ti.template()
+):
+    """Heat, thermal strains and velocity of point p; with ``kinematics`` (USL) also its motion
+    and stress."""
+    pt, nd, mat = ti.static(st.points, st.nodes, st.materials)
+    if ti.static(st.cfg.thermal):
+        if heat:
+            dT, dxi = g2p_heat(st.cfg, pt, nd, mat, st.scalars, p, base, w, dw)
+            if ti.static(st.cfg.th_strain and st.cfg.mech):
+                thermal_strain_step(st.cfg, pt, mat, p, dT, dxi)
+        if ti.static(st.cfg.th_strain and st.cfg.mech):
+            pt.iso_strain[p] += pt.iso_strain_step[p]
+    if ti.static(st.cfg.mech):
+        g2p_velocity(st.cfg, pt, nd, p, base, w, dw)
+        if ti.static(kinematics):
+            L = g2p_kinematics(st.cfg, pt, nd, p, base, w, dw, dt)
+            stress_update(st.cfg, pt, mat, p, L, dt)
+
+
+@ti.func
+def watch(st: ti.template(), p):
+    """Keep the first step at which point p ran hot, inverted or went NaN (fields.WATCHED)."""
+    pt, sc = ti.static(st.points, st.scalars)
+    k = sc.step[None]
+    T = pt.T[p]
+    if T > st.cfg.T_runaway or not (T == T):
+        ti.atomic_min(sc.first_hot[None], k)
+    if pt.J[p] <= 0.0:
+        ti.atomic_min(sc.first_inverted[None], k)
+    x = pt.x[p]
+    if not (x[0] == x[0] and x[1] == x[1] and pt.J[p] == pt.J[p]):
+        ti.atomic_min(sc.first_nan[None], k)
+
+
+@ti.func
+def g2p(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    pt, nd = ti.static(st.points, st.nodes)
+    dt = st.scalars.dt[None]
+    musl = ti.static(st.cfg.update == Update.MUSL)
+    for p in range(st.cfg.n_points):
+        base, w, dw = point_stencil(st.cfg, pt, p)
+        g2p_point(st, p, base, w, dw, dt, not musl, heat)
+        watch(st, p)
+    if ti.static(musl and st.cfg.mech):
+        for I in ti.grouped(ti.ndrange(*active(st.box))):
+            nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
+        for p in range(st.cfg.n_points):
+            base, w, dw = point_stencil(st.cfg, pt, p)
+            p2g_momentum(st.cfg, pt, nd, p, base, w, dw)
+        for I in ti.grouped(ti.ndrange(*active(st.box))):
+            grid_remap_velocity(st.cfg, nd, I)
+        for p in range(st.cfg.n_points):
+            base, w, dw = point_stencil(st.cfg, pt, p)
+            L = g2p_kinematics(st.cfg, pt, nd, p, base, w, dw, dt)
+            stress_update(st.cfg, pt, st.materials, p, L, dt)
+
+
+@ti.func
+def advance_clock(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    st.scalars.t[None] = st.scalars.t[None] + st.scalars.dt[None]
+    st.scalars.step[None] += 1
+
+
+# The order of one step, written once.
+STAGES = (
+    active_region,
+    clear_grid,
+    p2g,
+    grid_prepare,
+    surface_force,
+    heat_flux,
+    grid_update,
+    g2p,
+    advance_clock,
+)
+SURFACE = STAGES.index(surface_force)
+
+
+@ti.func
+def substep(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    for stage in ti.static(STAGES):
+        stage(st, heat, geom)
+
+
+@ti.kernel
+def advance_serial(st: ti.template(), n: ti.i32):
+    """CPU layout: n steps in one call."""
+    ti.loop_config(serialize=True)
+    for _ in range(n):
+        k = st.scalars.step[None]
+        substep(st, k % st.cfg.heat_every == 0, k % st.cfg.geom_every == 0)
+
+
+@ti.kernel
+def advance_one(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """GPU layout: one step per call, each stage a parallel loop."""
+    substep(st, heat, geom)
+
+
+@ti.kernel
+def run_stage(st: ti.template(), stage: ti.template(), heat: ti.template(), geom: ti.template()):
+    """One stage as its own kernel call (the staged layout)."""
+    stage(st, heat, geom)
+
+
+def _clocks(st: State, k: int) -> tuple[bool, bool]:
+    return k % st.cfg.heat_every == 0, k % st.cfg.geom_every == 0
+
+
+def advance(st: State, n: int) -> None:
+    """n steps in the state's layout: serial (one call) or parallel (one call per step). The
+    layout is fixed when the state is made: it decides which loops are unrolled."""
+    if st.cfg.parallel:
+        k = int(st.scalars.step[None])
+        for i in range(k, k + n):
+            advance_one(st, *_clocks(st, i))
+    else:
+        advance_serial(st, n)
+
+
+def advance_staged(st: State, n: int) -> None:
+    """n steps, every stage its own kernel call (the speed benchmark's comparison)."""
+    if not st.cfg.parallel:
+        raise ValueError("advance_staged needs a state made with the parallel layout")
+    k = int(st.scalars.step[None])
+    for i in range(k, k + n):
+        for stage in STAGES:
+            run_stage(st, stage, *_clocks(st, i))
+
+
+@ti.kernel
+def level_set_only(st: ti.template()):
+    """The level set of eq. 21 of the current points, for monitors (also with surface tension
+    off). Leaves the curvature the step keeps between rebuilds untouched."""
+    active_region(st, False, True)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        st.nodes.phi_raw[I] = st.cfg.phi_cap
+    for p in range(st.cfg.n_points):
+        base, w, dw = point_stencil(st.cfg, st.points, p)
+        scatter_level_set(st.cfg, st.points, st.nodes, p, base)
+    level_set(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.kernel
+def surface_only(st: ti.template()):
+    """Grid mass, level set, curvature and capillary force of the current points, without a
+    step (diagnostics and verification): the step's stages through the surface force."""
+    for stage in ti.static(STAGES[: SURFACE + 1]):
+        stage(st, True, True)

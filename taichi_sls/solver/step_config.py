@@ -1,0 +1,139 @@
+"""The compile-time configuration of a step: grid geometry, physics switches, named codes and
+derived constants. Kernels read it through ``ti.static``, so a case compiles only the physics it
+uses; everything that may change during a run (time step, clocks, laser settings) lives in
+fields instead."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..config import Case
+from ..physics.codes import StressReading, Transfer, Update, WallMechanical
+from ..physics.materials import KELVIN
+from .scene import Scene
+
+T_RUNAWAY_K = 1e4  # no polymer state of this model lives above it (the guard's bound too)
+
+
+@dataclass(frozen=True)
+class StepConfig:
+    # ---- grid (array indices: node (off, off) sits at x = y = 0)
+    dim: int
+    n_points: int
+    nx: int
+    ny: int
+    off: int
+    ncx: int  # cells across the domain
+    ncy: int
+    h: float
+    inv_h: float
+    lp: float  # uGIMP half-width of a point (h/4 for 2x2 per cell)
+    cell_volume: float
+    # ---- physics switches
+    mech: bool
+    thermal: bool
+    surface: bool
+    plastic: bool
+    th_strain: bool
+    laser: bool
+    n_lasers: int
+    gravity: tuple[float, float]
+    has_gravity: bool
+    stress_reading: StressReading
+    # ---- transfers and layout
+    transfer: Transfer
+    flip_ratio: float
+    update: Update
+    parallel: bool  # one parallel kernel call per step (GPU) or serialized steps (CPU)
+    active_region: bool
+    box_margin: int  # nodes beyond the points' footprint that the step still changes
+    # ---- clocks
+    heat_every: int
+    geom_every: int
+    # ---- walls (left, right, bottom, top)
+    wall_mechanical: tuple[WallMechanical, ...]
+    wall_fixed: tuple[bool, ...]
+    wall_T: tuple[float, ...]  # K
+    any_fixed: bool
+    # ---- mass and surface tension
+    rho_ref: float
+    mass_cut: float
+    gamma: float
+    r_p: float
+    band: int
+    redistance: bool
+    phi_cap: float
+    blur_passes: int
+    smooth_passes: int
+    kappa_cap: float
+    csf_c0: float
+    zero_net_force: bool
+    # ---- the guard's watch (solver/step.py): a temperature beyond this has run away
+    T_runaway: float
+
+
+def parallel_layout(case: Case) -> bool:
+    """One parallel kernel call per step (True) or many serialized steps per call (False)."""
+    lay = case.solver.layout
+    if lay == "auto":
+        return case.solver.arch == "gpu"
+    return lay == "parallel"
+
+
+def step_config(case: Case, scene: Scene, heat_every: int, curvature_every: int) -> StepConfig:
+    """The configuration of ``case`` on ``scene`` with the resolved clocks."""
+    ph, st, sv = case.physics, case.surface_tension, case.solver
+    walls = case.boundary.walls()
+    h = scene.h
+    first = case.materials[case.bodies[0].material]
+    surface = ph.surface_tension and ph.mechanics
+    thermal = ph.thermal
+    return StepConfig(
+        dim=2,
+        n_points=scene.n_points,
+        nx=scene.nx,
+        ny=scene.ny,
+        off=scene.off,
+        ncx=int(round(scene.width / h)),
+        ncy=int(round(scene.height / h)),
+        h=h,
+        inv_h=1.0 / h,
+        lp=h / (2 * case.grid.points_per_cell),
+        cell_volume=h**2,
+        mech=ph.mechanics,
+        thermal=thermal,
+        surface=surface,
+        plastic=ph.plasticity,
+        th_strain=ph.thermal_strain and thermal,
+        laser=thermal and any(las.power_W > 0 for las in case.lasers),
+        n_lasers=len(case.lasers),
+        gravity=tuple(ph.gravity_m_s2),
+        has_gravity=any(g != 0.0 for g in ph.gravity_m_s2),
+        stress_reading=StressReading.PAPER if sv.stress_reading == "paper" else StressReading.MODEL,
+        transfer=Transfer[sv.transfer.upper()],
+        flip_ratio=sv.flip_ratio,
+        update=Update[sv.update.upper()],
+        parallel=parallel_layout(case),
+        active_region=sv.active_region,
+        # the level-set band and the blur's reach, plus one for the 3x3 fits
+        box_margin=st.band_cells + st.level_set_smoothing_passes + 2 if surface else 0,
+        heat_every=heat_every if thermal else 1,
+        geom_every=curvature_every if surface else 1,
+        wall_mechanical=tuple(WallMechanical[w.mechanical.upper()] for w in walls),
+        wall_fixed=tuple(w.thermal == "fixed" for w in walls),
+        wall_T=tuple(w.temperature_C + KELVIN for w in walls),
+        any_fixed=thermal and any(w.thermal == "fixed" for w in walls),
+        rho_ref=first.density_kg_m3,
+        mass_cut=sv.small_mass * first.density_kg_m3 * h**2,
+        gamma=first.surface_tension_N_m,
+        r_p=st.point_radius_over_h * h,
+        band=st.band_cells,
+        redistance=st.level_set == "redistanced",
+        phi_cap=(st.band_cells + 1) * h,
+        blur_passes=st.level_set_smoothing_passes,
+        smooth_passes=st.smoothing_passes,
+        kappa_cap=st.curvature_cap_h / h if st.curvature_cap_h > 0 else 0.0,
+        csf_c0=st.colour_threshold,
+        zero_net_force=st.zero_net_force,
+        T_runaway=T_RUNAWAY_K,
+    )

@@ -1,0 +1,152 @@
+"""Verification of the mechanics: the vibrating bar, the manufactured solution, the Perzyna
+return map at one point."""
+
+import math
+import time
+
+import numpy as np
+
+from ...config import CaseError, Material
+from .. import references as ref
+from .common import Result, material, result, samples, transfer_label
+from .setups import simulation
+from .spec import VerificationCase
+
+
+def run_bar(vc: VerificationCase) -> Result:
+    """Fixed-free bar in its first axial mode: centre-of-mass velocity against (2 v0/pi)
+    cos(w t) (references.bar_com_velocity), max over 40 samples, relative to 2 v0/pi."""
+    case = vc.case
+    t0 = time.perf_counter()
+    sim = simulation(vc)
+    st = sim.state
+    m = st.points.mass.to_numpy()
+    mat = material(case)
+    L = case.bodies[0].max_um[0] * 1e-6
+    v0 = vc.spec.velocity_amplitude_m_s
+    ts, vc = samples(
+        sim, 40, case.time.end_s, lambda: float((m * st.points.v.to_numpy()[:, 0]).sum() / m.sum())
+    )
+    # symplectic Euler: the point velocities after a step sit half a step behind the positions
+    # (leapfrog), so the analytic velocity is taken at t - dt/2; otherwise an O(dt) phase lag
+    exact = ref.bar_com_velocity(ts[1:] - 0.5 * sim.dt, L, mat.youngs_solid_Pa, 1.0, v0)
+    err = float(np.max(np.abs(vc[1:] - exact))) / (2 * v0 / np.pi)
+    amp_cells = v0 / ref.bar_omega(L, mat.youngs_solid_Pa, mat.density_kg_m3) / st.cfg.h
+    return result(case, sim, {"com_velocity": err}, t0, amplitude_cells=amp_cells)
+
+
+def run_steffen(vc: VerificationCase) -> Result:
+    """Manufactured solution of a fixed-fixed bar (references.steffen_displacement): RMS over the
+    points of the displacement error, max over 20 samples, relative to the amplitude A."""
+    case = vc.case
+    t0 = time.perf_counter()
+    sim = simulation(vc)
+    st = sim.state
+    mat = material(case)
+    L = case.bodies[0].max_um[0] * 1e-6
+    A = vc.spec.displacement_amplitude_um * 1e-6
+    X = st.points.x0.to_numpy()[:, 0]
+
+    def rms() -> float:
+        u = st.points.x.to_numpy()[:, 0] - X
+        exact = ref.steffen_displacement(X, sim.t, L, A, mat.youngs_solid_Pa, mat.density_kg_m3)
+        return float(np.sqrt(np.mean((u - exact) ** 2)))
+
+    _, errs = samples(sim, 20, case.time.end_s, rms)
+    return result(case, sim, {"displacement_rms": float(errs.max()) / A}, t0)
+
+
+def perzyna_history(mat: Material, strains: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
+    """Drive one point of the solver's return map (constitutive.perzyna_update) through the
+    pure-shear strains eps_xy; returns (||s||, alpha) after every step."""
+    import taichi as ti
+
+    from ...physics.codes import StressReading
+    from ...physics.constitutive import embed3, perzyna_update
+    from ...physics.materials import material_struct
+    from ...solver.params import material_values
+    from ...solver.simulation import init_taichi
+
+    init_taichi(optimize=False)
+    n = len(strains)
+    mf = material_struct().field(shape=1)
+    mf.from_numpy({k: np.array([v]) for k, v in material_values(mat, 0.0).items()})
+    e = ti.field(float, n)
+    e.from_numpy(strains)
+    out = ti.field(float, (n, 2))
+
+    @ti.kernel
+    def drive():
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            epl = ti.Matrix.zero(float, 3, 3)
+            a = 0.0
+            for k in range(n):
+                eps = ti.Matrix([[0.0, e[k]], [e[k], 0.0]])
+                sig, epl2, a2 = perzyna_update(
+                    mf[0], embed3(eps), epl, a, 0.0, 1.0, 300.0, dt, True, StressReading.MODEL
+                )
+                epl = epl2
+                a = a2
+                s = sig - sig.trace() / 3.0 * ti.Matrix.identity(float, 3)
+                out[k, 0] = s.norm()
+                out[k, 1] = a
+
+    drive()
+    r = out.to_numpy()
+    return r[:, 0], r[:, 1]
+
+
+def run_perzyna(vc: VerificationCase) -> Result:
+    """Perzyna return map at one point (eqs. 40-45), time step dt = case.time.dt_s:
+
+    - ``rate_vs_closed_form``: constant-rate pure shear against the continuous closed form
+      (references.perzyna_shear_constant_rate), max |s| error over the run / final |s|;
+    - ``rate_vs_discrete``: the same against the step-by-step reference (round-off);
+    - ``relaxation_ratio``: at a held strain, max relative error of the overstress ratio per step
+      against (tau/dt)/(tau/dt + 1 + H/3mu) (references.perzyna_relaxation_ratio).
+    """
+    case = vc.case
+    t0 = time.perf_counter()
+    mat = material(case)
+    v = vc.spec
+    mu = mat.youngs_solid_Pa / (2 * (1 + mat.poisson))
+    sy, H, eta = mat.yield_solid_Pa, mat.hardening_solid_Pa, mat.viscosity_Pas
+    if mat.viscosity_model != "constant":
+        raise CaseError("verification.kind = 'perzyna': needs viscosity_model = 'constant'")
+    dt = float(case.time.dt_s)
+    n = int(round(case.time.end_s / dt))
+    t = dt * np.arange(1, n + 1)
+    s, a = perzyna_history(mat, v.shear_rate_1_s * t / 2.0, dt)
+    _, s_ref, a_ref = ref.perzyna_shear_discrete(n, dt, v.shear_rate_1_s, mu, sy, H, eta)
+    s_c, _ = ref.perzyna_shear_constant_rate(t, v.shear_rate_1_s, mu, sy, H, eta)
+    scale = float(np.abs(s_ref).max())
+    discrete = max(
+        float(np.abs(s - s_ref[1:]).max()) / scale,
+        float(np.abs(a - a_ref[1:]).max()) / max(float(a_ref.max()), 1e-300),
+    )
+    # load to the held strain in 50 steps, then hold it for 30
+    n_load, n_hold = 50, 30
+    strains = np.concatenate(
+        [np.linspace(0, v.hold_strain, n_load + 1)[1:], [v.hold_strain] * n_hold]
+    )
+    s2, a2 = perzyna_history(mat, strains, dt)
+    f = s2 - math.sqrt(2 / 3) * (sy + H * a2)
+    ratio = f[n_load:] / f[n_load - 1 : -1]
+    exact = ref.perzyna_relaxation_ratio(dt, eta / (2 * mu), mu, H)
+    errors = {
+        "rate_vs_closed_form": float(np.abs(s - s_c).max()) / scale,
+        "rate_vs_discrete": discrete,
+        "relaxation_ratio": float(np.abs(ratio / exact - 1.0).max()),
+    }
+    return Result(
+        case=case.case.name,
+        h_um=case.grid.spacing_um,
+        dt_s=dt,
+        errors=errors,
+        wall_s=time.perf_counter() - t0,
+        steps=n + n_load + n_hold,
+        transfer=transfer_label(case),  # no grid transfer: the label keeps the rows together
+        precision=case.solver.precision,
+        info={"tau_s": eta / (2 * mu), "overstress_at_hold": float(f[n_load - 1])},
+    )

@@ -1,0 +1,240 @@
+"""Verification case files: a case plus a ``[verification]`` table naming the analytic comparison
+and the initial conditions or loads that ordinary case keys cannot express.
+
+The table belongs to the studies, not to the case schema: :func:`split` takes it off the raw
+data before the case is validated. Resolution parameter of :func:`load`, by kind:
+- ``bar``, ``steffen``: cells along the bar (the cross-section is one cell of points);
+- ``stefan``: cells across the melt depth X_m at the end time (the slab is 5 X_m long);
+- ``curvature``, ``laplace``, ``viscous_decay``, ``inviscid``: R/h of the disc;
+- ``hopper``, ``hopper_shape``: R0/h of each cylinder;
+- ``perzyna``: time steps over the constant-rate drive;
+- every other kind: the grid spacing in um.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+from pydantic import Field, ValidationError
+
+from ...config import Case, CaseError, bundled_cases, case_from_dict, deep_update, read_toml
+from ...config.errors import case_error
+from ...config.loading import bundled_root, find_case
+from ...config.model import Model, Pair
+from .. import references as ref
+
+Kind = Literal[
+    "none",
+    "bar",
+    "steffen",
+    "perzyna",
+    "erf",
+    "gaussian",
+    "stefan",
+    "energy",
+    "curvature",
+    "laplace",
+    "square",
+    "viscous_decay",
+    "inviscid",
+]
+
+
+class VerificationSpec(Model):
+    """The ``[verification]`` table: which comparison, and its initial fields or loads. Only
+    ``bar``, ``steffen`` and ``gaussian`` change the run itself; the other kinds name the measure
+    that the accuracy study takes."""
+
+    kind: Kind = Field("none", description="which comparison; none: a plain case")
+    velocity_amplitude_m_s: float = Field(
+        0.0,
+        ge=0,
+        description="bar: initial x-velocity v0 sin(pi x / 2L) of body 0 (a rectangle from x = 0, "
+        "L its length), the first axial mode of a bar fixed at x = 0",
+    )
+    displacement_amplitude_um: float = Field(
+        0.0,
+        ge=0,
+        description="steffen: A of the manufactured displacement u = A sin(2 pi X/L) "
+        "sin(pi c t/L), c = sqrt(E/rho), driven by the body force it implies "
+        "(references.steffen_body_force)",
+    )
+    center_um: Pair = Field([0.0, 0.0], description="gaussian: centre (um)")
+    sigma_um: float = Field(0.0, ge=0, description="gaussian: initial standard deviation s0 (um)")
+    rise_C: float = Field(
+        0.0, description="gaussian: initial peak rise over thermal.initial_C, rise exp(-r^2/2 s0^2)"
+    )
+    shear_rate_1_s: float = Field(
+        0.0, ge=0, description="perzyna: engineering shear rate of the constant-rate drive (1/s)"
+    )
+    hold_strain: float = Field(
+        0.0, ge=0, description="perzyna: shear strain eps_xy held fixed for the relaxation check"
+    )
+
+
+@dataclass
+class VerificationCase:
+    """A validated case and its verification table."""
+
+    case: Case
+    spec: VerificationSpec
+
+
+def split(data: dict) -> tuple[dict, dict | None]:
+    """(case data, the ``[verification]`` table or None) of raw TOML data."""
+    data = dict(data)
+    return data, data.pop("verification", None)
+
+
+def _check(case: Case, v: VerificationSpec) -> None:
+    def need(key: str, value: float, why: str) -> None:
+        if not value > 0:
+            raise CaseError(
+                f"verification.{key} = {value}: must be > 0 for kind = {v.kind!r} ({why})"
+            )
+
+    if v.kind in ("bar", "steffen"):
+        b = case.bodies[0]
+        if b.shape != "rect" or b.min_um[0] != 0.0:
+            raise CaseError(
+                f"verification.kind = {v.kind!r}: bodies[0] must be a rectangle starting at "
+                f"x = 0 (the fixed end), got shape = {b.shape!r}, min_um = "
+                f"{getattr(b, 'min_um', None)}"
+            )
+        if not case.physics.mechanics:
+            raise CaseError(f"verification.kind = {v.kind!r}: needs physics.mechanics = true")
+        if v.kind == "bar":
+            need("velocity_amplitude_m_s", v.velocity_amplitude_m_s, "the initial velocity")
+        else:
+            need("displacement_amplitude_um", v.displacement_amplitude_um, "the manufactured field")
+    elif v.kind == "gaussian":
+        need("sigma_um", v.sigma_um, "the initial width")
+        if not case.physics.thermal:
+            raise CaseError("verification.kind = 'gaussian': needs physics.thermal = true")
+    elif v.kind == "perzyna":
+        need("shear_rate_1_s", v.shear_rate_1_s, "the constant-rate drive")
+        need("hold_strain", v.hold_strain, "the relaxation check")
+
+
+def from_dict(data: dict) -> VerificationCase:
+    """Validate raw data of a verification case file."""
+    case_data, table = split(data)
+    try:
+        spec = VerificationSpec.model_validate(table or {})
+    except ValidationError as e:
+        err = case_error(e, VerificationSpec, table)
+        raise CaseError(f"verification.{err}") from None
+    case = case_from_dict(case_data)
+    _check(case, spec)
+    return VerificationCase(case, spec)
+
+
+def is_verification_file(path: str | Path) -> bool:
+    """Whether a case file carries a ``[verification]`` table."""
+    return "verification" in read_toml(find_case(path), "case file")
+
+
+def load_file(path: str | Path, overrides: list[str] | None = None) -> VerificationCase:
+    """A verification case file with ``--set`` overrides (``verification.*`` keys included)."""
+    from ...config.loading import apply_override
+
+    path = find_case(path)
+    data = read_toml(path, "case file")
+    for o in overrides or []:
+        apply_override(data, o)
+    data.setdefault("case", {}).setdefault("name", path.stem)
+    return from_dict(data)
+
+
+# ------------------------------------------------------------------------------ resolution
+
+
+def case_path(name: str) -> Path:
+    return bundled_root() / "verification" / f"{name}.toml"
+
+
+def case_names() -> list[str]:
+    return [p.stem for p in bundled_cases("verification")]
+
+
+def _disc_geometry(data: dict, R_over_h: float) -> None:
+    """Disc of the case at R/h: domain 2R(1 + |eps|) + 12 h square, centre off the grid lines so
+    that the seeding is not symmetric about a node."""
+    b = data["bodies"][0]
+    R = b["radius_um"]
+    h = R / R_over_h
+    W = h * math.ceil((2 * R * (1 + abs(b.get("perturbation", 0.0))) + 12 * h) / h)
+    data["grid"]["spacing_um"] = h
+    data["domain"] = {"width_um": W, "height_um": W}
+    b["center_um"] = [W / 2 + 0.123 * h, W / 2 + 0.377 * h]
+
+
+def _bar_geometry(data: dict, cells: int, fixed_fixed: bool) -> None:
+    b = data["bodies"][0]
+    L = b["max_um"][0]
+    h = L / cells
+    data["grid"]["spacing_um"] = h
+    data["domain"] = {"width_um": L if fixed_fixed else L + 4 * h, "height_um": 4 * h}
+    b["max_um"] = [L, h]
+
+
+def _slab_length(data: dict, h: float, length: float) -> None:
+    """A 1D slab along x: `length` rounded up to whole cells, two cells of points tall."""
+    W = h * math.ceil(length / h - 1e-9)
+    data["grid"]["spacing_um"] = h
+    data["domain"] = {"width_um": W, "height_um": 4 * h}
+    data["bodies"][0]["min_um"] = [0.0, 0.0]
+    data["bodies"][0]["max_um"] = [W, 2 * h]
+
+
+def stefan_slab(case: Case) -> ref.StefanSlab:
+    """The melting slab of a stefan verification case (body 0's material, the left wall)."""
+    m = case.materials[case.bodies[0].material]
+    return ref.StefanSlab(
+        case.thermal.initial_C,
+        case.boundary.left.temperature_C,
+        m.crystallization_C,
+        m.melt_C,
+        m.conductivity_solid_W_mK,
+        m.density_kg_m3,
+        m.heat_capacity_solid_J_kgK,
+        m.latent_heat_J_kg,
+    )
+
+
+def stefan_melt_depth_um(case: Case) -> float:
+    Xm, _ = ref.mushy_stefan_fronts(case.time.end_s, stefan_slab(case))
+    return float(Xm) * 1e6
+
+
+def load(name: str, resolution: float | None = None, sets: dict | None = None) -> VerificationCase:
+    """Verification case ``name`` (bundled cases/verification/NAME.toml) at a resolution (module
+    docstring), with ``sets`` (nested dict) merged in first."""
+    path = case_path(name)
+    if not path.is_file():
+        raise CaseError(
+            f"verification case {name!r} does not exist; available: {', '.join(case_names())}"
+        )
+    data = deep_update(read_toml(path, "verification case"), sets or {})
+    data.setdefault("case", {}).setdefault("name", name)
+    data.setdefault("grid", {})
+    kind = data.get("verification", {}).get("kind", "none")
+    if resolution is not None:
+        if kind in ("bar", "steffen"):
+            _bar_geometry(data, int(resolution), kind == "steffen")
+        elif kind in ("curvature", "laplace", "viscous_decay", "inviscid"):
+            _disc_geometry(data, float(resolution))
+        elif kind == "stefan":
+            Xm = stefan_melt_depth_um(from_dict(data).case)
+            _slab_length(data, Xm / float(resolution), 5.0 * Xm)
+        elif kind == "erf":
+            _slab_length(data, float(resolution), data["domain"]["width_um"])
+        elif kind == "perzyna":
+            data.setdefault("time", {})["dt_s"] = data["time"]["end_s"] / int(resolution)
+            data["time"]["allow_unstable_dt"] = True  # a point-level drive: no grid limit
+        else:
+            data["grid"]["spacing_um"] = float(resolution)
+    return from_dict(data)

@@ -1,0 +1,195 @@
+"""Tests for taichi_sls.output: files written, readable, atomic, and robust to odd input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import imageio.v3 as iio
+import meshio
+import numpy as np
+import pytest
+
+from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
+from taichi_sls.io.series import plot_series
+from taichi_sls.io.writer import OutputWriter
+
+DOMAIN = (0.0, 80.0, 0.0, 48.0)
+MELT_C = 180.0
+
+
+def two_discs(h: float = 1.0, r: float = 12.0) -> np.ndarray:
+    """Points on an h-spaced lattice inside two touching discs (like two powder grains)."""
+    g = np.arange(-r, r + h / 2, h)
+    xx, yy = np.meshgrid(g, g)
+    disc = np.column_stack([xx.ravel(), yy.ravel()])
+    disc = disc[(disc**2).sum(axis=1) <= r * r]
+    return np.vstack([disc + (40.0 - r, r), disc + (40.0 + r, r)])
+
+
+def synthetic(step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    x = two_discs()
+    # Hot spot on top of the left disc, growing with step: part of it is above melt.
+    T = 25.0 + (170.0 + 30.0 * step) * np.exp(-((x[:, 0] - 28.0) ** 2 + (x[:, 1] - 24.0) ** 2) / 60)
+    lf = np.clip((T - MELT_C) / 5.0, 0.0, 1.0)
+    u = 0.1 * step * np.hypot(x[:, 0] - 40.0, x[:, 1]) / 40.0
+    return x, T, u, lf
+
+
+@pytest.fixture
+def writer(tmp_path: Path) -> OutputWriter:
+    return OutputWriter(tmp_path / "run", domain_um=DOMAIN, melt_C=MELT_C, vtu=True)
+
+
+def test_full_run(writer: OutputWriter) -> None:
+    out = writer.out_dir
+    assert (out / "frames").is_dir()
+    writer.write_case('[case]\nname = "two_discs"\n')
+    for i in range(3):
+        x, T, u, lf = synthetic(i)
+        assert (T > MELT_C).any() and (T < MELT_C).any()
+        writer.frame(i, i * 25e-6, x, T, u, lf)
+        writer.row({"t_s": i * 25e-6, "contact_line_um": 2.0 + i, "T_max_C": float(T.max())})
+    writer.summary({"ok": True, "neck_um": np.float32(3.5), "bad": float("nan"), "n": np.int64(3)})
+    writer.finish()
+
+    assert writer.frames_written == 3
+    assert (out / "case.toml").read_text() == '[case]\nname = "two_discs"\n'
+
+    for i in range(3):
+        png = out / "frames" / f"frame_{i:04d}.png"
+        assert png.stat().st_size < 200_000
+        im = iio.imread(png)
+        assert im.ndim == 3 and im.shape[2] in (3, 4)
+        assert im.shape[1] > im.shape[0] > 150  # two panels side by side
+        assert im[..., :3].std() > 10  # not blank
+
+    gif = iio.imread(out / "animation.gif", index=None)
+    assert gif.shape[0] == 3
+    assert (out / "animation.gif").stat().st_size < 2_000_000
+
+    with (out / "timeseries.csv").open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == ["t_s", "contact_line_um", "T_max_C"]
+    assert len(rows) == 4
+    assert float(rows[2][0]) == 25e-6  # round-trip precision
+    assert iio.imread(out / "timeseries.png").ndim == 3
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary == {"ok": True, "neck_um": 3.5, "bad": None, "n": 3}
+
+    files = [d.get("file") for d in ET.parse(out / "points.pvd").iter("DataSet")]
+    times = [float(d.get("timestep")) for d in ET.parse(out / "points.pvd").iter("DataSet")]
+    assert files == [f"vtu/points_{i:04d}.vtu" for i in range(3)]
+    assert times == [0.0, 25e-6, 50e-6]
+    mesh = meshio.read(out / files[1])
+    x, T, _, _ = synthetic(1)
+    assert mesh.points.shape == (len(x), 3)
+    np.testing.assert_allclose(mesh.point_data["T_C"], T)
+    assert not list(out.rglob(".*.tmp"))
+
+
+def test_atomic_write(tmp_path: Path) -> None:
+    p = tmp_path / "a.txt"
+    atomic_write_text(p, "old")
+    atomic_write_text(p, "new content")
+    assert p.read_text() == "new content"
+    atomic_write_bytes(tmp_path / "b.bin", b"\x00\x01")
+    assert (tmp_path / "b.bin").read_bytes() == b"\x00\x01"
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["a.txt", "b.bin"]
+
+
+def test_atomic_write_failure_keeps_old(tmp_path: Path) -> None:
+    p = tmp_path / "a.txt"
+    atomic_write_text(p, "old")
+    with pytest.raises(TypeError):
+        atomic_write_bytes(p, "not bytes")  # type: ignore[arg-type]
+    assert p.read_text() == "old"
+    assert [f.name for f in tmp_path.iterdir()] == ["a.txt"]
+
+
+@pytest.mark.parametrize(
+    "x, T",
+    [
+        (np.array([[40.0, 10.0]]), np.array([300.0])),  # one point, molten
+        (two_discs()[:2], np.array([25.0, 25.0])),  # two points
+        (two_discs(), np.full(len(two_discs()), MELT_C)),  # all equal, exactly at melt
+        (np.zeros((5, 2)), np.full(5, 200.0)),  # coincident points
+        (np.zeros((0, 2)), np.zeros(0)),  # no points
+        (two_discs(), np.full(len(two_discs()), np.nan)),  # all NaN
+    ],
+)
+def test_degenerate_frames(tmp_path: Path, x: np.ndarray, T: np.ndarray) -> None:
+    w = OutputWriter(
+        tmp_path, domain_um=DOMAIN, melt_C=MELT_C, vtu=True, deformation="plastic_strain"
+    )
+    lf = (T > MELT_C).astype(float)
+    w.frame(0, 0.0, x, T, np.zeros(len(x)), lf)
+    w.frame(1, 1e-6, x, T, np.zeros(len(x)), np.ones(len(x)))
+    w.finish()
+    assert iio.imread(tmp_path / "animation.gif", index=None).shape[0] == 2
+    assert (tmp_path / "vtu" / "points_0001.vtu").is_file()
+    if len(x):  # meshio cannot read back a zero-point VTU (its own writer's output)
+        assert meshio.read(tmp_path / "vtu" / "points_0001.vtu").points.shape == (len(x), 3)
+
+
+def test_mismatched_lengths_raise(writer: OutputWriter) -> None:
+    x, T, u, lf = synthetic(0)
+    with pytest.raises(ValueError, match="T_C"):
+        writer.frame(0, 0.0, x, T[:-1], u, lf)
+
+
+def test_bad_deformation(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="deformation"):
+        OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, deformation="strain")
+
+
+def test_finish_without_rows_or_frames(tmp_path: Path) -> None:
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    w.finish()  # nothing written: must not raise
+    w.row({"t_s": 0.0, "T_max_C": 25.0})
+    w.finish()  # one row: plot skipped
+    assert not (tmp_path / "timeseries.png").exists()
+    assert not (tmp_path / "animation.gif").exists()
+
+
+def test_row_columns_and_values(tmp_path: Path) -> None:
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    w.row({"t_s": 0.1, "a": 1, "b": float("inf")})
+    w.row({"b": math.pi, "t_s": 0.2, "c": np.float32(0.5)})  # new key appended, order fixed
+    with (tmp_path / "timeseries.csv").open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows == [
+        ["t_s", "a", "b", "c"],
+        ["0.1", "1", "inf", ""],
+        ["0.2", "", repr(math.pi), "0.5"],
+    ]
+
+
+def test_plot_series_missing_column(tmp_path: Path) -> None:
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    for i in range(4):
+        w.row({"t_s": i * 1e-6, "contact_line_um": float(i)})
+    png = tmp_path / "p.png"
+    assert plot_series(tmp_path / "timeseries.csv", png, ["contact_line_um", "T_max_C"])
+    assert iio.imread(png).ndim == 3
+    assert not plot_series(tmp_path / "timeseries.csv", png, ["missing"])
+
+
+def test_gif_size_limit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from taichi_sls.io import gif as output
+
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, dpi=40)
+    for i in range(12):
+        x, T, u, lf = synthetic(i % 4)
+        w.frame(i, i * 1e-6, x + (i % 7, 0.0), T, u, lf)
+    monkeypatch.setattr(output, "GIF_MAX_BYTES", 60_000)
+    monkeypatch.setattr(output, "_GIF_BUDGET", 54_000)
+    monkeypatch.setattr(output, "_GIF_MIN_FRAMES", 4)
+    w.finish()
+    gif = tmp_path / "animation.gif"
+    assert gif.stat().st_size <= 60_000
+    assert 2 <= iio.imread(gif, index=None).shape[0] < 12

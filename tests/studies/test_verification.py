@@ -1,0 +1,144 @@
+"""The verification cases (cases/verification/): loading, their options, and one small run of the
+cases that no physics test file covers. The full study: ``python -m taichi_sls.bench accuracy``
+or ``pytest -m slow``."""
+
+import math
+
+import numpy as np
+import pytest
+
+from taichi_sls.config import CaseError
+from taichi_sls.solver.scene import build_scene
+from taichi_sls.studies import references as ref
+from taichi_sls.studies import verification as ver
+
+
+def test_every_verification_case_loads_with_its_kind():
+    names = ver.case_names()
+    assert len(names) >= 13
+    kinds = {ver.load(n).spec.kind for n in names}
+    assert kinds == set(ver.RUNNERS)  # one case file at least for every comparison
+
+
+DISC = {"shape": "disc", "center_um": [27.0, 27.0], "radius_um": 20.0, "material": "fluid"}
+RECT = {"shape": "rect", "min_um": [14.0, 14.0], "max_um": [34.0, 34.0]}
+
+
+@pytest.mark.parametrize(
+    "name, sets, key",
+    [
+        ("viscous_decay", {"bodies": [DISC | {"perturbation": 0.6}]}, "perturbation"),
+        ("viscous_decay", {"bodies": [DISC | {"perturbation": 0.05, "mode": 1}]}, "mode"),
+        ("square", {"bodies": [RECT | {"perturbation": 0.1}]}, "perturbation"),
+        ("bar", {"verification": {"velocity_amplitude_m_s": 0.0}}, "velocity_amplitude_m_s"),
+        ("steffen", {"verification": {"displacement_amplitude_um": -1.0}}, "displacement"),
+        ("gaussian", {"verification": {"sigma_um": 0.0}}, "sigma_um"),
+        ("perzyna", {"verification": {"kind": "bogus"}}, "verification.kind"),
+        (
+            "bar",
+            {"bodies": [DISC | {"center_um": [2.0, 2.0], "radius_um": 1.0, "material": "bar"}]},
+            "rectangle",
+        ),
+    ],
+)
+def test_bad_verification_options_name_the_key(name, sets, key):
+    with pytest.raises(CaseError, match=key):
+        ver.load(name, sets=sets)
+
+
+def test_unknown_verification_case_lists_the_available():
+    with pytest.raises(CaseError, match="available: .*bar"):
+        ver.load("no_such_case")
+
+
+def test_perturbed_disc_is_seeded_with_its_mode():
+    sc = build_scene(ver.load("viscous_decay", 20).case)
+    eps = ver.mode_amplitude(sc.x, sc.vol, 2)
+    other = ver.mode_amplitude(sc.x, sc.vol, 3)
+    print(f"seeded eps_2 = {eps:.4f} (0.05 asked), eps_3 = {other:.1e}")
+    # measured 0.0497 and eps_3 = -1.0e-3 at R/h = 20: the staircase of the seeding costs ~1 %
+    assert eps == pytest.approx(0.05, rel=0.03)
+    assert abs(other) < 2e-3
+
+
+def test_steffen_body_force_satisfies_the_momentum_equation():
+    """rho u_tt = d(E ln F)/dX + rho b at random (X, t), by central differences."""
+    L, A, E, rho = 25e-6, 0.5e-6, 100.0, 1.0
+    rng = np.random.default_rng(3)
+    X = rng.uniform(0, L, 50)
+    t = rng.uniform(0, 5e-6, 50)
+    dX, dt = 1e-4 * L, 1e-4 * 5e-6
+
+    def u(x, s):
+        return ref.steffen_displacement(x, s, L, A, E, rho)
+
+    utt = (u(X, t + dt) - 2 * u(X, t) + u(X, t - dt)) / dt**2
+
+    def P(x):
+        return E * np.log1p((u(x + dX / 2, t) - u(x - dX / 2, t)) / dX)
+
+    dPdX = (P(X + dX / 2) - P(X - dX / 2)) / dX
+    b = ref.steffen_body_force(X, t, L, A, E, rho)
+    scale = np.abs(utt).max()
+    np.testing.assert_allclose(rho * utt, dPdX + rho * b, atol=1e-5 * scale)
+    v = (u(X, t + dt) - u(X, t - dt)) / (2 * dt)
+    np.testing.assert_allclose(
+        ref.steffen_velocity(X, t, L, A, E, rho), v, atol=1e-6 * scale * 1e-6
+    )
+
+
+def test_maxwell_decay_rate_limits():
+    lam = ref.viscous_decay_rate(2, 0.0363, 0.3, 20e-6)
+    assert lam == pytest.approx(0.0363 / (0.3 * 20e-6))  # n = 2: gamma / (eta_N R)
+    assert ref.maxwell_decay_rate(lam, 0.0) == lam
+    assert ref.maxwell_decay_rate(lam, 1e-6) == pytest.approx(lam / (1 + lam * 1e-6))
+
+
+def test_steffen_manufactured_solution_converges():
+    errs = [ver.run(ver.load("steffen", n)).errors["displacement_rms"] for n in (8, 16)]
+    print("Steffen manufactured bar, RMS displacement / A at 8, 16 cells:", errs)
+    # measured 5.4e-2, 2.1e-2 (order 1.4; 6.8e-3 at 32 cells). Tolerance: under 3 % at 16 cells
+    # and at least order 1 between the two
+    assert errs[1] < 0.03
+    assert errs[1] < 0.5 * errs[0]
+
+
+def test_gaussian_spreading_2d():
+    r = ver.run(ver.load("gaussian", 2.0))
+    print("Gaussian spreading at h = 2 um:", r.errors)
+    # measured: RMS 1.64e-3 of the initial rise, peak 2.5 % (h = 2 um, s0 = 3 h); second order
+    # in the study. Tolerance: RMS under 0.25 %, peak under 4 %
+    assert r.errors["temperature_rms"] < 2.5e-3
+    assert r.errors["peak"] < 0.04
+
+
+def test_viscous_decay_of_a_disc_mode_is_slow_at_coarse_resolution():
+    """R/h = 10: the fitted decay rate of the n = 2 mode against n gamma / (2 eta_N R). The
+    target (3 % at R/h = 20) is missed; this records the coarse-grid bias so that a change in it
+    shows (the study: -37 %, -13 % at R/h = 10, 20, converging)."""
+    r = ver.run(ver.load("viscous_decay", 10, {"time": {"end_s": 6e-5}}))
+    print("viscous decay, R/h = 10:", r.errors, r.info)
+    # measured -0.37 (rate 3.8e3 1/s against 6.05e3). Tolerance: the decay is slower than the
+    # reference by 25-50 % (a fitted rate, the log-linear fit over 6e-5 s is exact for a pure
+    # exponential)
+    assert -0.5 < r.errors["decay_rate"] < -0.25
+    assert r.info["rate_1_s"] > 0
+
+
+def test_inviscid_disc_oscillates_near_the_rayleigh_period():
+    r = ver.run(ver.load("inviscid", 10))
+    print("inviscid period, R/h = 10:", r.errors, r.info)
+    # measured +0.26 at R/h = 10 (+0.097 at 20). Tolerance: it oscillates (two zero crossings,
+    # the runner raises otherwise) with a period within 35 % of 2 pi / omega
+    assert abs(r.errors["period"]) < 0.35
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["viscous_decay", "inviscid"])
+def test_surface_oscillations_converge_under_refinement(name):
+    sets = {"time": {"end_s": 6e-5}} if name == "viscous_decay" else {}
+    errs = [ver.run(ver.load(name, rh, sets)).errors for rh in (10, 20)]
+    key = "decay_rate" if name == "viscous_decay" else "period"
+    print(name, errs)
+    assert abs(errs[1][key]) < 0.6 * abs(errs[0][key])
+    assert math.isfinite(errs[1][key])
