@@ -25,6 +25,11 @@ from .config.loading import add_set_argument
 os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "False")
 
 
+# exit status of ``run`` by the run's status: a run to solidification that gives up at
+# time.max_s is not a success
+EXIT_CODES = {"complete": 0, "failed": 1, "max_time": 3, "interrupted": 130}
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
 
@@ -59,7 +64,7 @@ def writable_folder(out: Path) -> None:
 
 def run_command(args: argparse.Namespace) -> int:
     """The main job: load, check, run, print the outcome."""
-    from .jobs.case_run import run_case
+    from .jobs.case_run import print_outcome, run_case
     from .solver.time_step import resolve_dt
     from .studies.verification import setups, spec
 
@@ -103,10 +108,10 @@ def run_command(args: argparse.Namespace) -> int:
         f"{fin['contact_line_um']:.2f} um -> {out}",
         file=sys.stderr,
     )
+    print_outcome(summary)
     if summary["status"] == "failed":
         print(f"error: {summary['error']}", file=sys.stderr)
-        return 1
-    return 0 if summary["status"] == "complete" else 130
+    return EXIT_CODES[summary["status"]]
 
 
 def case_command(args: argparse.Namespace) -> int:

@@ -19,6 +19,7 @@ from .sections import (
     Boundary,
     CaseInfo,
     Domain,
+    Fusion,
     Grid,
     Laser,
     Output,
@@ -54,6 +55,7 @@ class Case(Model):
     lasers: list[Laser] = Field(default_factory=list)
     surface_tension: SurfaceTension = Field(default_factory=SurfaceTension)
     output: Output = Field(default_factory=Output)
+    fusion: Fusion = Field(default_factory=Fusion)
 
     @model_validator(mode="before")
     @classmethod
@@ -110,7 +112,22 @@ class Case(Model):
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+        if self.time.stop == "solidified" and self.time.max_s <= self.lasers_off_s():
+            raise CaseError(
+                f"time.max_s = {self.time.max_s}: must exceed the time every laser is off "
+                f"({self.lasers_off_s():g} s)"
+            )
         return self
+
+    def lasers_off_s(self) -> float:
+        """The time after which no laser heats (s): switched off, or scanned past x_end_um."""
+        ends = [0.0]
+        for las in self.lasers:
+            end = las.off_s
+            if las.speed_m_s != 0.0 and las.x_end_um is not None:
+                end = min(end, las.on_s + (las.x_end_um - las.x_start_um) * 1e-6 / las.speed_m_s)
+            ends.append(max(end, las.on_s) if las.power_W > 0 else 0.0)
+        return max(ends)
 
     def perimeter_um(self) -> float:
         """Total outline length of the bodies as seeded (um)."""

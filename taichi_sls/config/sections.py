@@ -96,7 +96,22 @@ class Time(Model):
     dt_s: AutoPositive = Field(
         "auto", description='time step (s), or "auto" from the stability limits'
     )
-    end_s: float = Field(1e-3, gt=0, description="simulated end time (s)")
+    end_s: float = Field(1e-3, gt=0, description='simulated end time (s) of stop = "end"')
+    stop: Literal["end", "solidified"] = Field(
+        "end",
+        description="end: run to end_s; solidified: once every laser is off, run until every "
+        "point is solid (T <= T_c) and the kinetic energy has fallen below "
+        "settled_kinetic_fraction of the surface energy, or to max_s (then marked max_time)",
+    )
+    max_s: float = Field(
+        0.5, gt=0, description='simulated time at which a stop = "solidified" run gives up (s)'
+    )
+    settled_kinetic_fraction: float = Field(
+        1e-4,
+        gt=0,
+        description="settled: kinetic energy (with the inertia scale) below this fraction of "
+        "gamma times the bodies' perimeter",
+    )
     safety: float = Field(0.4, gt=0, description='fraction of the stability limit for "auto"')
     allow_unstable_dt: bool = Field(False, description="let a fixed dt exceed the stability limit")
     heat_every: AutoCount = Field(
@@ -141,6 +156,15 @@ class Solver(Model):
         "stencil, level-set band and smoothing margin); false: every node, every step",
     )
     precision: Literal["f64", "f32"] = Field("f64", description="floating point precision")
+    mass_scale: float = Field(
+        1.0,
+        ge=1.0,
+        description="inertia scale s >= 1: the momentum equation sees s times the mass (heat "
+        "capacity, weight and the thermal field keep the physical one); the elastic and "
+        "capillary time-step limits grow by sqrt(s). For slow viscous or quasi-static flow "
+        "(Ohnesorge >> 1); the kinetic_ratio monitor says when inertia starts to matter "
+        "(docs/speed.md)",
+    )
     small_mass: float = Field(
         1e-9, ge=0, description="nodes below this fraction of a full cell's mass are skipped"
     )
@@ -164,9 +188,42 @@ class Solver(Model):
     )
 
 
+class Fusion(Model):
+    """The verdict of a run: does this laser setting fuse the pair?"""
+
+    neck_growth: float = Field(
+        0.05,
+        ge=0,
+        description="fused: the neck at the end exceeds the initial one by this fraction and the "
+        "neck region melted through",
+    )
+    neck_region_cells: float = Field(
+        1.0,
+        gt=0,
+        description="the neck region: points within this many cells of the mid-plane between "
+        "bodies 0 and 1 (at the start)",
+    )
+    melted_through: float = Field(
+        0.99,
+        gt=0,
+        le=1,
+        description="melted through: this fraction of the neck region's points was fully molten "
+        "(above T_m) at some time",
+    )
+
+
 class Thermal(Model):
     initial_C: float = Field(140.0, description="initial temperature of every body without its own")
     enthalpy_reference_C: float = Field(0.0, description="temperature where enthalpy is zero")
+    subgrid_filter: float = Field(
+        1.0,
+        ge=0,
+        description="rate of the sub-grid temperature filter, in units of 1 / the thermal "
+        "stability limit h^2 rho c / 4k: each heat step removes 1 - exp(-rate dt_heat / limit) "
+        "of the points' sub-grid temperature noise (energy-conserving; physics/thermal.py). "
+        "Increments alone never damp it, and stirred by the flow it grew to 6 K below the plate "
+        "over 30 ms; rates of 3 and more overshoot at a sharp front; 0: increments alone (FLIP)",
+    )
 
 
 class Laser(Model):
@@ -261,7 +318,16 @@ class SurfaceTension(Model):
 
 
 class Output(Model):
-    frames: int = Field(20, gt=0, le=100000, description="number of output frames over the run")
+    frames: int = Field(
+        20, gt=0, le=100000, description="number of output frames over the run (linear spacing)"
+    )
+    spacing: Literal["auto", "linear", "log"] = Field(
+        "auto",
+        description="frame times: linear (frames over end_s), log (frames_per_decade from "
+        'first_frame_s); auto: linear for stop = "end", log for "solidified"',
+    )
+    frames_per_decade: int = Field(10, gt=0, le=1000, description="log spacing: frames per decade")
+    first_frame_s: float = Field(1e-6, gt=0, description="log spacing: time of the first frame")
     png: bool = Field(True, description="write frames/*.png")
     gif: bool = Field(True, description="write animation.gif from the frames")
     vtu: bool = Field(False, description="write ParaView point data (points_*.vtu + points.pvd)")

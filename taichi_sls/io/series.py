@@ -64,6 +64,19 @@ class SeriesWriter:
             w.writerow(cells + [""] * (n - len(cells)))
         atomic_write_text(self.path, buf.getvalue())
 
+    def rows(self) -> list[dict[str, float]]:
+        """The rows so far, as numbers (empty cells as NaN)."""
+        out = []
+        for cells in self._lines:
+            row = {}
+            for k, v in zip(self.header, cells, strict=False):
+                try:
+                    row[k] = float(v)
+                except ValueError:
+                    row[k] = float("nan")
+            out.append(row)
+        return out
+
     def resume(self) -> None:
         """Keep the rows an earlier run wrote."""
         if self.path.is_file():

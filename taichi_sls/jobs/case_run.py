@@ -1,9 +1,10 @@
-"""The main job: run one case to its end, writing every output.
+"""The main job: run one case to its end (``time.stop``), writing every output.
 
 Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``animation.gif``,
-``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``summary.json``, the resolved
-``case.toml`` and, with ``output.vtu = true``, ParaView point data. Every file is written
-atomically; an interrupted or failed run still leaves valid files and a summary that says so.
+``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``outcome.png``,
+``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
+``output.vtu = true``, ParaView point data. Every file is written atomically; an interrupted or
+failed run still leaves valid files and a summary that says so.
 """
 
 from __future__ import annotations
@@ -17,25 +18,36 @@ from pathlib import Path
 from typing import Any
 
 from ..config import Case, case_to_toml
+from ..io.outcome_plot import plot_outcome
 from ..io.writer import OutputWriter
 from ..solver.guard import SimulationError
 from ..solver.scene import Scene
 from ..solver.simulation import Simulation
+from .outcome import NeckHistory, describe, neck_region, outcome
+from .progress import Progress
+from .schedule import frame_steps, settled
+
+# statuses: complete (end_s reached, or solidified and settled), max_time (stop = solidified
+# gave up at time.max_s), failed (the guard), interrupted (Ctrl-C, SIGTERM)
+STATUSES = ("complete", "max_time", "failed", "interrupted")
 
 
-def _progress(total_steps: int, dt: float):
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return None
-    return tqdm(
-        total=total_steps,
-        unit="step",
-        unit_scale=True,
-        dynamic_ncols=True,
-        desc="t = 0 us",
-        file=sys.stderr,
-        mininterval=0.5,
+def _writer(case: Case, out_dir: Path) -> OutputWriter:
+    o, g = case.output, case.grid
+    return OutputWriter(
+        out_dir,
+        domain_um=(
+            -g.ghost_cells * g.spacing_um,
+            case.domain.width_um + g.ghost_cells * g.spacing_um,
+            -g.ghost_cells * g.spacing_um,
+            case.domain.height_um,
+        ),
+        melt_C=min(m.melt_C for m in case.materials.values()),
+        png=o.png,
+        gif=o.gif,
+        vtu=o.vtu,
+        dpi=o.dpi,
+        deformation=o.deformation,
     )
 
 
@@ -49,7 +61,7 @@ def run_case(
     scene: Scene | None = None,
     before_step: Callable[[Simulation], None] | None = None,
 ) -> dict[str, Any]:
-    """Run one case to its end time, writing every output. Returns the summary.
+    """Run one case to its end (``time.stop``), writing every output. Returns the summary.
 
     ``checkpoint_every`` > 0 writes ``checkpoint.npz`` every that many frames; ``resume``
     continues from such a checkpoint into the same output folder (bitwise the same result as an
@@ -59,31 +71,20 @@ def run_case(
     wall0 = time.perf_counter()
     sim = Simulation(case, scene=scene, before_step=before_step)
     sc = sim.scene
-    o = case.output
-    writer = OutputWriter(
-        out_dir,
-        domain_um=(
-            -case.grid.ghost_cells * case.grid.spacing_um,
-            case.domain.width_um + case.grid.ghost_cells * case.grid.spacing_um,
-            -case.grid.ghost_cells * case.grid.spacing_um,
-            case.domain.height_um,
-        ),
-        melt_C=min(m.melt_C for m in case.materials.values()),
-        png=o.png,
-        gif=o.gif,
-        vtu=o.vtu,
-        dpi=o.dpi,
-        deformation=o.deformation,
-    )
+    writer = _writer(case, out_dir)
     writer.write_case(case_to_toml(case))
-    n_frames = o.frames
-    # whole steps per frame, rounded up so that the run reaches end_s
-    steps_per_frame = max(1, math.ceil(case.time.end_s / n_frames / sim.dt - 1e-9))
-    total = steps_per_frame * n_frames
+    schedule = list(frame_steps(case, sim.dt))
+    solidify = case.time.stop == "solidified"
+    horizon = case.time.max_s if solidify else schedule[-1] * sim.dt
     print(
         f"{case.case.name}: {sc.n_points} points, {sc.table1_nodes} nodes "
         f"(domain + ghost layer; {sc.nx * sc.ny} in the arrays), dt = {sim.dt:.3g} s, "
-        f"{total} steps, compile {sim.compile_s:.1f} s",
+        + (
+            f"until solidified (at most {case.time.max_s:g} s, {schedule[-1]} steps)"
+            if solidify
+            else f"{schedule[-1]} steps"
+        )
+        + f", compile {sim.compile_s:.1f} s",
         file=sys.stderr,
     )
     summary: dict[str, Any] = {
@@ -94,14 +95,20 @@ def run_case(
         "nodes_in_arrays": sc.nx * sc.ny,
         "dt_s": sim.dt,
         "dt_limits_s": sim.dt_limits,
+        "mass_scale": case.solver.mass_scale,
         "compile_s": sim.compile_s,
     }
+    history = NeckHistory()
+    warnings: list[str] = []
 
-    def frame(index: int) -> dict[str, float]:
-        mon = sim.monitors()
+    def frame(index: int, guard: bool = True) -> dict[str, float]:
+        mon = sim.monitors(guard=guard)
         writer.row(mon)
+        history.add(mon)
         snap = sim.snapshot()
-        deform = snap["displacement_um" if o.deformation == "displacement" else "plastic_strain"]
+        deform = snap[
+            "displacement_um" if case.output.deformation == "displacement" else "plastic_strain"
+        ]
         writer.frame(index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"])
         return mon
 
@@ -110,6 +117,8 @@ def run_case(
         extra = sim.load_checkpoint(resume)
         k0 = int(extra["frame"])
         writer.resume()
+        for row in writer.series.rows():
+            history.add(row)
         prev = out_dir / "summary.json"
         first = json.loads(prev.read_text())["initial"] if prev.is_file() else sim.monitors()
         print(f"resumed from {resume} at frame {k0}, t = {sim.t:.6g} s", file=sys.stderr)
@@ -117,45 +126,68 @@ def run_case(
         first = frame(0)
     summary["initial"] = first
     last = first
-    bar = _progress(total, sim.dt) if progress else None
-    if bar is not None:
-        bar.update(sim.steps)
+    walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
+    bar = Progress(
+        horizon,
+        sim.t,
+        enabled=progress,
+        solidify=solidify,
+        T_c=min(m.crystallization_C for m in case.materials.values()),
+        T_wall=min(walls) if walls else math.nan,
+    )
     step_wall = 0.0
     steps0 = sim.steps
-    chunk = max(1, min(steps_per_frame, 2000))
     try:
-        for k in range(k0 + 1, n_frames + 1):
-            done = 0
-            while done < steps_per_frame:
-                n = min(chunk, steps_per_frame - done)
+        for k in range(k0 + 1, len(schedule) + 1):
+            while sim.steps < schedule[k - 1]:
+                n = min(2000, schedule[k - 1] - sim.steps)
                 t0 = time.perf_counter()
                 sim.advance(n)
                 step_wall += time.perf_counter() - t0
-                done += n
-                if bar is not None:
-                    bar.update(n)
-                    sps = (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0
-                    bar.set_description(f"t = {sim.t * 1e6:.1f} us, {sps:,.0f} steps/s")
+                bar.update(sim.t, (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0)
             last = frame(k)
+            bar.note(last)
             if checkpoint_every and k % checkpoint_every == 0:
                 sim.save_checkpoint(out_dir / "checkpoint.npz", {"frame": k})
-        summary["status"] = "complete"
+            if last.get("kinetic_ratio", 0.0) > 1e-2 and case.solver.mass_scale > 1.0:
+                warnings.append(
+                    f"t = {sim.t:.3g} s: kinetic energy {last['kinetic_ratio']:.2g} of the "
+                    "surface energy with solver.mass_scale = "
+                    f"{case.solver.mass_scale:g}: inertia matters, the scale is too large"
+                )
+            if solidify and settled(last, case, sim.t):
+                break
+        solid = last["molten_fraction"] == 0.0
+        summary["status"] = (
+            "max_time" if solidify and not settled(last, case, sim.t) else "complete"
+        )
     except SimulationError as e:
         summary["status"] = "failed"
         summary["error"] = str(e)
         # the offending state beside the last good frame: full state and one more image
-        sim.save_checkpoint(out_dir / "failed_state.npz", {"frame": n_frames})
-        last = sim.monitors(guard=False)  # the broken state's monitors, for the summary
-        snap = sim.snapshot()
-        deform = snap["displacement_um" if o.deformation == "displacement" else "plastic_strain"]
-        writer.frame(
-            writer.next_index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"]
-        )
+        sim.save_checkpoint(out_dir / "failed_state.npz", {"frame": len(schedule)})
+        last = frame(writer.next_index, guard=False)
+        solid = False
     except KeyboardInterrupt:
         summary["status"] = "interrupted"
+        solid = False
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
+        pt = sim.state.points
+        in_neck = neck_region(case, pt.x0.to_numpy(), sc.body, pt.mass.to_numpy())
+        summary["outcome"] = outcome(
+            case,
+            history,
+            last,
+            pt.time_molten.to_numpy(),
+            in_neck,
+            solidified=solid and summary["status"] == "complete",
+        )
+        if summary["status"] == "max_time":
+            warnings.append(
+                f"time.max_s = {case.time.max_s:g} s reached before the pair solidified and "
+                "settled: the outcome is not final"
+            )
         summary.update(
             steps=sim.steps,
             simulated_s=sim.t,
@@ -164,7 +196,16 @@ def run_case(
             steps_per_s=(sim.steps - steps0) / step_wall if step_wall > 0 else math.nan,
             final=last,
             T_peak_C=last.get("T_peak_C"),
+            warnings=list(dict.fromkeys(warnings)),
         )
         writer.summary(summary)
         writer.finish()
+        plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
     return summary
+
+
+def print_outcome(summary: dict[str, Any]) -> None:
+    """The outcome lines of a finished run, on stderr."""
+    print(describe(summary["outcome"]), file=sys.stderr)
+    for w in summary.get("warnings", []):
+        print(f"warning: {w}", file=sys.stderr)

@@ -7,6 +7,11 @@ Transfers (``solver.transfer``, :class:`~taichi_sls.physics.codes.Transfer`):
   which is diagonal and position dependent for GIMP (between h^2/8 and h^2/4).
 Positions follow eq. 15 (the PIC grid velocity) in every variant.
 
+Inertia (``solver.mass_scale`` s): the grid mass, and so the momentum and every acceleration
+of the momentum equation, is s times the points' mass; gravity's weight, the heat capacity and
+the thermal field keep the physical mass. The grid mass still serves as the colour of the
+surface methods through ``rho_ref`` = s rho.
+
 Update (``solver.update``): USL moves the points with the grid velocity v^{n+1} = v^n + dt f/m
 as eqs. 14-17 print it; MUSL (modified USL, Sulsky et al. 1995; Bardenhagen 2002) first updates
 the point velocities, maps their momenta back to the grid, and moves the points and computes L with
@@ -29,10 +34,22 @@ from .shape import STENCIL, node_weight
 
 
 @ti.func
+def inertia(cfg: ti.template(), m):
+    """The mass the momentum equation sees: m times ``mass_scale`` (inertia scaling, for slow
+    viscous or quasi-static flow; 1: the physical mass)."""
+    out = m
+    if ti.static(cfg.mass_scale != 1.0):
+        out = m * cfg.mass_scale
+    return out
+
+
+@ti.func
 def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
-    """Mass, momentum, internal force -V_p sigma_p grad N (eq. 11) and body force (eq. 12)."""
+    """Mass, momentum, internal force -V_p sigma_p grad N (eq. 11) and body force (eq. 12).
+    The grid's mass is the inertia: ``mass_scale`` times the point's (its weight stays)."""
     xp = pt.x[p]
     mp = pt.mass[p]
+    mi = inertia(cfg, mp)
     vp = pt.v[p]
     Vp = pt.volume0[p] * pt.J[p]
     sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
@@ -45,8 +62,8 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         mv = vp
         if ti.static(cfg.transfer == Transfer.APIC):
             mv += pt.C[p] @ (node_x(cfg, I) - xp)
-        nd.mass[I] += N * mp
-        nd.momentum[I] += N * mp * mv
+        nd.mass[I] += N * mi
+        nd.momentum[I] += N * mi * mv
         f = -Vp * (sig @ gN)
         if ti.static(cfg.has_gravity):
             f += N * mp * g
@@ -145,7 +162,7 @@ def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
 def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
     """MUSL: the updated point momenta back to the grid (affine part included for APIC)."""
     xp = pt.x[p]
-    mp = pt.mass[p]
+    mp = inertia(cfg, pt.mass[p])
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         I = base + o

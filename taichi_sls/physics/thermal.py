@@ -8,6 +8,18 @@ sign of MODEL.md, eq. 30's laser term with eq. 31 read as W/m^3); dT_i = dt Q_i 
 gains enthalpy dH_p = c_p sum N_ip dT_i. Since sum_p M_p c_p N_ip / c_i = 1 this moves exactly the
 grid's heat to the points: the energy balance holds to round-off.
 
+Sub-grid filter (``thermal.subgrid_filter``, chi per heat step): the grid sees a point's
+temperature only through the capacity-weighted node average, so increments alone (FLIP) never
+damp a point's
+deviation d_p = T_p - sum N T_i from the grid field; stirred by the flow (spurious capillary
+currents), such sub-grid noise grows over long runs until points lie below the coldest wall.
+Physically it would vanish within a heat step (its diffusion time at the point spacing is far
+shorter). Each heat step the noise part of d -- d_p minus the grid interpolation of the
+capacity-weighted node means of d -- is removed at the fraction chi = 1 - exp(-rate dt_heat /
+t_thermal) (a relaxation in time, independent of the heat clock), as enthalpy: exactly
+conservative, and of order h^4 on a smooth field (d is then smooth), so the scheme stays second
+order.
+
 Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
 increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
@@ -85,12 +97,29 @@ def p2g_heat_flux(
     t,
     dt,
 ):
-    """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate."""
+    """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate;
+    with the sub-grid filter on, the point's deviation from the grid temperature too."""
     gT = ti.Vector.zero(float, cfg.dim)
+    T_grid = 0.0
+    w_fixed = 0.0
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         gT += nd.T[base + o] * gN
+        if ti.static(cfg.subgrid_filter > 0.0):
+            T_grid += N * nd.T[base + o]
+            if ti.static(cfg.any_fixed):
+                fixed, Tw = fixed_temperature(cfg, base + o)
+                if fixed:
+                    w_fixed += N
     mp = mat[pt.material[p]]
+    if ti.static(cfg.subgrid_filter > 0.0):
+        if w_fixed == 0.0:  # points beside a fixed wall take the grid temperature anyway
+            mc = pt.mass[p] * apparent_heat_capacity(mp, pt.T[p])
+            d = pt.T[p] - T_grid
+            for o in ti.static(ti.grouped(STENCIL)):
+                N, gN = node_weight(w, dw, o)
+                nd.deviation[base + o] += N * mc * d
+                nd.deviation_capacity[base + o] += N * mc
     k = lerp_phase(pt.solid_fraction[p], mp.conductivity_solid_W_mK, mp.conductivity_liquid_W_mK)
     Vp = pt.volume0[p] * pt.J[p]
     s = 0.0
@@ -138,6 +167,8 @@ def g2p_heat(
     dTg = 0.0
     T_pic = 0.0
     w_fixed = 0.0
+    T_grid = 0.0  # the grid temperature at the point, before the increment
+    d_smooth = 0.0  # the smooth part of the points' deviation from it
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         I = base + o
@@ -147,10 +178,20 @@ def g2p_heat(
             fixed, Tw = fixed_temperature(cfg, I)
             if fixed:
                 w_fixed += N
+        if ti.static(cfg.subgrid_filter > 0.0):
+            T_grid += N * nd.T[I]
+            if nd.deviation_capacity[I] > 0.0:
+                d_smooth += N * nd.deviation[I] / nd.deviation_capacity[I]
     mp = mat[pt.material[p]]
     T0 = pt.T[p]
     xi0 = pt.solid_fraction[p]
-    dH = apparent_heat_capacity(mp, T0) * dTg
+    c0 = apparent_heat_capacity(mp, T0)
+    dH = c0 * dTg
+    if ti.static(cfg.subgrid_filter > 0.0):
+        if w_fixed == 0.0:
+            # the sub-grid part of the deviation relaxes (module docstring): exactly
+            # conservative, since sum_p N m c (d_p - d_i) = 0 at every node
+            dH -= cfg.subgrid_filter * c0 * ((T0 - T_grid) - d_smooth)
     if ti.static(cfg.any_fixed):
         if w_fixed > 0.0:
             H_pic = enthalpy(mp, T_pic)

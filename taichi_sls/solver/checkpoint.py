@@ -27,6 +27,7 @@ POINT_MEMBERS = (
     "enthalpy",
     "T",
     "solid_fraction",
+    "time_molten",
 )
 SCALARS = ("t", "dt", "laser_energy", "heat_out", "T_peak")
 # the curvature is kept between rebuilds (surface_tension.curvature_every): part of the state

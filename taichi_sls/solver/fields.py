@@ -6,10 +6,12 @@ Points (``points``, one element per material point; SI):
   gradient; J its determinant; strain the accumulated small strain (eqs. 16-17); plastic_strain
   (3x3, plane strain); equivalent_plastic_strain (eq. 43); iso_strain the isotropic thermal and
   transformation strain (eqs. 36-37) and iso_strain_step its increment per mechanical step;
-  stress (3x3); volume0; mass; material (index); enthalpy (J/kg); T (K); solid_fraction (eq. 33).
+  stress (3x3); volume0; mass; material (index); enthalpy (J/kg); T (K); solid_fraction (eq. 33);
+  time_molten (s above T_m, the fusion verdict's input).
 Nodes (``nodes``, the grid of ``nx x ny``):
   mass, momentum, force; v_old = v^n and v = v^{n+1}; heat_capacity (eq. 28), capacity_T
-  (sum c T), T, heat_rate (eqs. 29-30), dT; the CSF method's phi_raw (eq. 21), phi (signed
+  (sum c T), T, heat_rate (eqs. 29-30), dT, deviation and deviation_capacity (the sub-grid
+  filter, physics/thermal.py); the CSF method's phi_raw (eq. 21), phi (signed
   distance), phi_smooth, kappa, scratch, flags (NodeFlag bits) and mass_gradient (eq. 20).
 Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, laser_energy,
   heat_out (heat through fixed-temperature walls), T_peak (running maximum), and for each of
@@ -68,6 +70,7 @@ POINT_MEMBERS = {
     "enthalpy": "scalar",
     "T": "scalar",
     "solid_fraction": "scalar",
+    "time_molten": "scalar",
 }
 NODE_MEMBERS = {
     "mass": "scalar",
@@ -80,6 +83,8 @@ NODE_MEMBERS = {
     "T": "scalar",
     "heat_rate": "scalar",
     "dT": "scalar",
+    "deviation": "scalar",
+    "deviation_capacity": "scalar",
     "phi_raw": "scalar",
     "phi": "scalar",
     "phi_smooth": "scalar",

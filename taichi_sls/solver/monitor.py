@@ -75,6 +75,7 @@ def point_monitors(st: State) -> tuple[dict[str, float], dict[str, float]]:
     r = {k: float(v) for k, v in st.totals.to_numpy().items()}
     public = {
         "T_max_C": r["T_max"] - KELVIN,
+        "T_min_C": r["T_min"] - KELVIN,
         "T_mean_C": r["mass_T"] / r["mass"] - KELVIN,
         "molten_fraction": r["molten_mass"] / r["mass"],
         "enthalpy_J_per_m": r["enthalpy"],

@@ -67,7 +67,14 @@ class Simulation:
         self.heat_every = resolve_heat_every(case, self.dt, self.dt_limits)
         self.curvature_every = resolve_curvature_every(case, self.dt, self.dt_limits)
         self.scene: Scene = build_scene(case) if scene is None else scene
-        cfg = step_config(case, self.scene, self.heat_every, self.curvature_every)
+        cfg = step_config(
+            case,
+            self.scene,
+            self.heat_every,
+            self.curvature_every,
+            self.dt,
+            self.dt_limits.get("thermal", math.inf),
+        )
         mats = material_arrays(case, self.scene.material_names)
         self.state = State(cfg, self.scene, mats, laser_arrays(case))
         self.state.scalars.dt[None] = self.dt
@@ -132,6 +139,11 @@ class Simulation:
         out["T_peak_C"] = float(st.scalars.T_peak[None] - KELVIN)
         out["laser_energy_J_per_m"] = float(st.scalars.laser_energy[None])
         out["heat_out_J_per_m"] = float(st.scalars.heat_out[None])
+        # inertia against the surface energy: small when the flow is quasi-static (the rule of
+        # solver.mass_scale and of the settled state of time.stop = "solidified")
+        out["kinetic_ratio"] = (
+            self.case.solver.mass_scale * out["kinetic_energy_J_per_m"] / self.surface_energy()
+        )
         cl, span = self.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6
@@ -150,6 +162,11 @@ class Simulation:
         rise = mon["enthalpy_J_per_m"] - self._H0
         net = mon["laser_energy_J_per_m"] - mon["heat_out_J_per_m"]
         return (net - rise) / (abs(self._H0) + mon["laser_energy_J_per_m"])
+
+    def surface_energy(self) -> float:
+        """gamma times the bodies' perimeter as seeded (J/m): the scale of the kinetic ratio."""
+        gamma = max(m.surface_tension_N_m for m in self.case.materials.values())
+        return max(gamma * self.case.perimeter_um() * 1e-6, 1e-30)
 
     def energy_bound(self) -> float:
         """Every energy a run can turn into motion: initial kinetic energy, surface energy of the

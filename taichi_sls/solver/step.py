@@ -89,6 +89,9 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
                 nd.heat_capacity[I] = 0.0
                 nd.capacity_T[I] = 0.0
                 nd.heat_rate[I] = 0.0
+                if ti.static(st.cfg.subgrid_filter > 0.0):
+                    nd.deviation[I] = 0.0
+                    nd.deviation_capacity[I] = 0.0
         if ti.static(st.cfg.surface):
             if geom:
                 nd.phi_raw[I] = st.cfg.phi_cap
@@ -180,6 +183,8 @@ def g2p_point(
     if ti.static(st.cfg.thermal):
         if heat:
             dT, dxi = g2p_heat(st.cfg, pt, nd, mat, st.scalars, p, base, w, dw)
+            if pt.solid_fraction[p] == 0.0:  # above T_m for this heat step
+                pt.time_molten[p] += dt * st.cfg.heat_every
             if ti.static(st.cfg.th_strain and st.cfg.mech):
                 thermal_strain_step(st.cfg, pt, mat, p, dT, dxi)
         if ti.static(st.cfg.th_strain and st.cfg.mech):

@@ -5,6 +5,7 @@ fields instead."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..config import Case
@@ -55,8 +56,10 @@ class StepConfig:
     wall_fixed: tuple[bool, ...]
     wall_T: tuple[float, ...]  # K
     any_fixed: bool
+    subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
     # ---- mass and surface tension
-    rho_ref: float
+    mass_scale: float  # inertia scale s (physics/mechanics.py)
+    rho_ref: float  # s times the first body's density: the grid mass of a full cell / V_c
     mass_cut: float
     gamma: float
     r_p: float
@@ -80,8 +83,15 @@ def parallel_layout(case: Case) -> bool:
     return lay == "parallel"
 
 
-def step_config(case: Case, scene: Scene, heat_every: int, curvature_every: int) -> StepConfig:
-    """The configuration of ``case`` on ``scene`` with the resolved clocks."""
+def step_config(
+    case: Case,
+    scene: Scene,
+    heat_every: int,
+    curvature_every: int,
+    dt: float = 0.0,
+    thermal_limit: float = math.inf,
+) -> StepConfig:
+    """The configuration of ``case`` on ``scene`` with the resolved time step and clocks."""
     ph, st, sv = case.physics, case.surface_tension, case.solver
     walls = case.boundary.walls()
     h = scene.h
@@ -123,8 +133,13 @@ def step_config(case: Case, scene: Scene, heat_every: int, curvature_every: int)
         wall_fixed=tuple(w.thermal == "fixed" for w in walls),
         wall_T=tuple(w.temperature_C + KELVIN for w in walls),
         any_fixed=thermal and any(w.thermal == "fixed" for w in walls),
-        rho_ref=first.density_kg_m3,
-        mass_cut=sv.small_mass * first.density_kg_m3 * h**2,
+        # the filter's fraction per heat step, from its rate per thermal limit
+        subgrid_filter=-math.expm1(-case.thermal.subgrid_filter * dt * heat_every / thermal_limit)
+        if thermal
+        else 0.0,
+        mass_scale=sv.mass_scale,
+        rho_ref=first.density_kg_m3 * sv.mass_scale,
+        mass_cut=sv.small_mass * first.density_kg_m3 * sv.mass_scale * h**2,
         gamma=first.surface_tension_N_m,
         r_p=st.point_radius_over_h * h,
         band=st.band_cells,

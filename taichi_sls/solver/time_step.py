@@ -17,21 +17,29 @@ def time_step_limits(case: Case) -> dict[str, float]:
         "thermal": ph.thermal,
         "surface_tension": ph.surface_tension and ph.mechanics,
     }
+    # inertia scaling lengthens the limits set by inertia (waves and capillary oscillation)
+    inertial = {"elastic": True, "surface_tension": True, "thermal": False}
+    s = math.sqrt(case.solver.mass_scale)
     out: dict[str, float] = {}
     for m in case.materials.values():
         for k, v in stability_limits(m, h).items():
             if keep.get(k, False):
-                out[k] = min(out.get(k, math.inf), v)
+                out[k] = min(out.get(k, math.inf), v * s if inertial[k] else v)
     return out
 
 
 def resolve_dt(case: Case) -> tuple[float, dict[str, float]]:
-    """(dt, limits): "auto" is ``time.safety`` times the smallest limit; a fixed dt above it is
-    refused unless ``time.allow_unstable_dt``."""
+    """(dt, limits): "auto" is ``time.safety`` times the smallest limit, and no more than the
+    heat step (``time.heat_step_fraction`` of the thermal limit: with the inertia scaled the
+    thermal limit can be the smallest, and a heat step near it overshoots); a fixed dt above the
+    smallest limit is refused unless ``time.allow_unstable_dt``."""
     limits = time_step_limits(case)
     bound = min(limits.values()) if limits else case.time.end_s
     if case.time.dt_s == "auto":
-        return case.time.safety * bound, limits
+        dt = case.time.safety * bound
+        if "thermal" in limits:
+            dt = min(dt, case.time.heat_step_fraction * limits["thermal"])
+        return dt, limits
     dt = float(case.time.dt_s)
     if dt > bound and not case.time.allow_unstable_dt:
         which = min(limits, key=limits.get)

@@ -1,0 +1,55 @@
+"""When a run writes its frames and checks whether to stop: linear over ``time.end_s`` or
+log-spaced from ``output.first_frame_s`` (the fusion outcome spans microseconds to tenths of a
+second), and the stop rule of ``time.stop``."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+from ..config import Case
+
+
+def uses_log_spacing(case: Case) -> bool:
+    o = case.output
+    if o.spacing == "auto":
+        return case.time.stop == "solidified"
+    return o.spacing == "log"
+
+
+def frame_steps(case: Case, dt: float) -> Iterator[int]:
+    """The step count of each frame after the first (frame 0 is the start), increasing.
+
+    Linear: ``output.frames`` frames of whole, equal step counts that reach ``time.end_s``.
+    Log: ``frames_per_decade`` per decade from ``first_frame_s`` (1 ms is on that grid when
+    first_frame_s is a power of ten), up to ``time.end_s`` for stop = "end", or ``time.max_s``
+    for stop = "solidified" (the run may stop before)."""
+    t = case.time
+    if not uses_log_spacing(case):
+        per = max(1, math.ceil(t.end_s / case.output.frames / dt - 1e-9))
+        yield from (per * k for k in range(1, case.output.frames + 1))
+        return
+    end = t.max_s if t.stop == "solidified" else t.end_s
+    o = case.output
+    last = 0
+    k = 0
+    while True:
+        tk = min(o.first_frame_s * 10.0 ** (k / o.frames_per_decade), end)
+        step = max(last + 1, round(tk / dt))
+        yield step
+        last = step
+        if tk >= end:
+            return
+        k += 1
+
+
+def settled(mon: dict[str, float], case: Case, t: float) -> bool:
+    """The stop rule of ``time.stop = "solidified"``: every laser is off, every point solid and
+    the kinetic energy (with the inertia scale) below ``settled_kinetic_fraction`` of the
+    surface energy."""
+    return (
+        t >= case.lasers_off_s()
+        and mon["molten_fraction"] == 0.0
+        and mon["T_max_C"] <= min(m.crystallization_C for m in case.materials.values())
+        and mon.get("kinetic_ratio", 0.0) < case.time.settled_kinetic_fraction
+    )
