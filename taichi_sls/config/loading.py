@@ -88,7 +88,7 @@ def case_from_dict(data: dict) -> Case:
         raise case_error(e, Case, data) from None
 
 
-def _resolve_files(data: dict, folder: Path) -> None:
+def resolve_files(data: dict, folder: Path) -> None:
     """Body files named relative to the case file, made absolute."""
     for b in data.get("bodies", []) if isinstance(data.get("bodies"), list) else []:
         f = b.get("vertices_file") if isinstance(b, dict) else None
@@ -105,7 +105,7 @@ def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
         apply_override(data, o)
     if "case" not in data or "name" not in data.get("case", {}):
         data.setdefault("case", {})["name"] = path.stem
-    _resolve_files(data, path.parent)
+    resolve_files(data, path.parent)
     return case_from_dict(data)
 
 

@@ -264,6 +264,49 @@ def _point_radius(v: float) -> float:
 
 
 class SurfaceTension(Model):
+    method: Literal["surface_energy", "csf"] = Field(
+        "surface_energy",
+        description="surface_energy: the gradient of gamma times the length of the c = 1/2 "
+        "outline of the node colour (the weak form of surface tension, Hyde et al. 2020; "
+        "physics/surface_energy.py; the surface_energy_* keys); csf: the paper's level set, "
+        "least-squares curvature and CSF force (eqs. 19-24; the keys from point_radius_over_h "
+        "to curvature_step_fraction)",
+    )
+    surface_energy_colour: Literal["mass", "volume"] = Field(
+        "mass",
+        description="surface_energy: colour from the node mass m_i / (rho V_c) (rho of the first "
+        "body's material) or from the point volumes sum V_p N_i / V_c",
+    )
+    surface_energy_colour_filter: bool = Field(
+        True,
+        description="surface_energy: contour the colour after one [1 2 1] / 4 pass along x and "
+        "y; without it a pair whose mid-plane lies on a node line keeps a one-cell notch at the "
+        "neck (the points of the two bodies never cross it)",
+    )
+    surface_energy_weight: Literal["hat", "gimp"] = Field(
+        "hat",
+        description="surface_energy: grad N_i at the Gauss points: hat (bilinear, the segment's "
+        "cell corners) or gimp (the solver's uGIMP)",
+    )
+    surface_energy_gauss_points: int = Field(
+        1,
+        gt=0,
+        le=3,
+        description="surface_energy: Gauss points per outline segment (1 is exact for the hat)",
+    )
+    surface_energy_mass_floor: float = Field(
+        0.01,
+        ge=0,
+        le=1,
+        description="surface_energy: a node below this fraction of a full cell's mass carries "
+        "only m_i / floor of its surface force (nodes at the edge of the points' support hold "
+        "almost no mass; their acceleration would be unbounded)",
+    )
+    surface_energy_floor_mode: Literal["spread", "clip"] = Field(
+        "spread",
+        description="surface_energy: the rest of a light node's surface force: spread to its "
+        "3x3 neighbours by mass (momentum kept) or clip (dropped: a static disc drifts)",
+    )
     point_radius_over_h: Annotated[float, AfterValidator(_point_radius)] = Field(
         0.375,
         gt=0,
@@ -308,6 +351,13 @@ class SurfaceTension(Model):
         description="curvature age as a fraction of the capillary limit for curvature_every = "
         '"auto"',
     )
+    ramp_s: float = Field(
+        0.0,
+        ge=0,
+        description="gamma rises linearly from 0 over this time (s), either method; 0: at once. "
+        "A body started stress-free rings at its breathing period when gamma switches on at "
+        "once (the Laplace verification case ramps it in)",
+    )
     initial_stress: Literal["laplace", "none"] = Field(
         "laplace",
         description="laplace: every disc starts in equilibrium with its own surface tension "
@@ -332,6 +382,12 @@ class Output(Model):
     gif: bool = Field(True, description="write animation.gif from the frames")
     vtu: bool = Field(False, description="write ParaView point data (points_*.vtu + points.pvd)")
     dpi: int = Field(80, gt=0, le=600, description="resolution of the frames")
+    neck_measure: Literal["auto", "colour", "level_set"] = Field(
+        "auto",
+        description="the interface the contact line is read on: colour ({c > 1/2}, the "
+        "surface-energy force's), level_set ({phi < 0} of eq. 21 with r_p, the paper's Fig. 4); "
+        "auto: the capillary force's own",
+    )
     deformation: Literal["displacement", "plastic_strain"] = Field(
         "displacement", description="what the right-hand panel colours the points by"
     )

@@ -46,7 +46,10 @@ def plot_outcome(
         ax_neck.axhline(s["contact_line_um"][0], color="C0", lw=0.8, ls=":")
     ax_neck.set_title("neck and melt over the run (dotted: the start)", fontsize=10)
     xi, xf = np.asarray(x_initial) * 1e6, np.asarray(x_final) * 1e6
-    ok = np.isfinite(xf).all(axis=1)
+    lo, hi = xi.min(axis=0), xi.max(axis=0)
+    span = hi - lo
+    # points that flew off (a failed run) would stretch the axes beyond drawing
+    ok = np.isfinite(xf).all(axis=1) & np.all(np.abs(xf - 0.5 * (lo + hi)) < 2 * span, axis=1)
     ax_shape.scatter(xi[:, 0], xi[:, 1], s=2, c="0.75", marker="s", lw=0, label="start")
     ax_shape.scatter(
         xf[ok, 0],

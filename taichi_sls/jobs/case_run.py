@@ -200,7 +200,10 @@ def run_case(
         )
         writer.summary(summary)
         writer.finish()
-        plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
+        try:
+            plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
+        except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
+            print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)
     return summary
 
 

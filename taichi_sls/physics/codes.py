@@ -45,3 +45,10 @@ class StressReading(IntEnum):
 
     MODEL = 0  # s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md)
     PAPER = 1  # eq. 39 and p = lambda tr(eps) as printed
+
+
+class SurfaceMethod(IntEnum):
+    """``surface_tension.method``."""
+
+    CSF = 0  # the paper's level set, curvature and CSF force (eqs. 19-24)
+    SURFACE_ENERGY = 1  # the gradient of gamma times the outline's length

@@ -11,7 +11,7 @@ import taichi as ti
 
 from .codes import NodeFlag
 from .curvature import curvature, extend_and_smooth
-from .grid import active
+from .grid import active, ramped_gamma
 from .level_set import blur_level_set, level_set
 
 CURVATURE = int(NodeFlag.CURVATURE)
@@ -45,7 +45,7 @@ def mass_gradient(cfg: ti.template(), box: ti.template(), nd: ti.template()):
 
 
 @ti.func
-def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: ti.template()):
+def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: ti.template(), t):
     """Eq. 19 with [m] = rho V_c and <m> = rho V_c / 2 (MODEL.md).
 
     Surface tension on a closed surface has no resultant, but the discrete CSF force keeps a
@@ -58,7 +58,7 @@ def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: t
     # concave pocket was flung out of the box.
     c0 = ti.static(cfg.csf_c0)
     full = cfg.rho_ref * cfg.cell_volume
-    coef = cfg.gamma / (cfg.rho_ref * (1.0 - c0) * (1.0 - c0))
+    coef = ramped_gamma(cfg, t) / (cfg.rho_ref * (1.0 - c0) * (1.0 - c0))
     if ti.static(cfg.zero_net_force):
         surf.resultant[None] = ti.Vector.zero(float, 3)
     for i, j in ti.ndrange(*active(box)):

@@ -1,4 +1,4 @@
-"""Node positions and the active region of the grid."""
+"""Node positions, the active region of the grid, and the capillary coefficient in time."""
 
 import taichi as ti
 
@@ -15,3 +15,12 @@ def active(box: ti.template(), shrink: ti.template() = 0):
     drops that many nodes at the upper end (1: the cells between active nodes)."""
     b = box[None]
     return (b[0], b[2] - shrink), (b[1], b[3] - shrink)
+
+
+@ti.func
+def ramped_gamma(cfg: ti.template(), t):
+    """gamma at time t: ``gamma_ramp_s`` > 0 lets it rise linearly from 0 (either method)."""
+    gamma = cfg.gamma
+    if ti.static(cfg.gamma_ramp_s > 0.0):
+        gamma *= ti.min(1.0, t / cfg.gamma_ramp_s)
+    return gamma

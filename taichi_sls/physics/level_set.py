@@ -16,6 +16,7 @@ the contour segments (``seg.ends`` up to two per cell, ``seg.count``).
 
 import taichi as ti
 
+from .contour import cell_segments
 from .grid import active
 
 
@@ -30,11 +31,6 @@ def scatter_level_set(cfg: ti.template(), pt: ti.template(), nd: ti.template(), 
 
 
 @ti.func
-def _crossing(pa, pb, fa, fb):
-    return pa + (fa / (fa - fb)) * (pb - pa)
-
-
-@ti.func
 def contour_segments(
     cfg: ti.template(), box: ti.template(), values: ti.template(), seg: ti.template()
 ):
@@ -42,52 +38,8 @@ def contour_segments(
     cell, in metres."""
     for i, j in ti.ndrange(*active(box, 1)):
         f = ti.Vector([values[i, j], values[i + 1, j], values[i + 1, j + 1], values[i, j + 1]])
-        inside = ti.Vector([0, 0, 0, 0])
-        n_in = 0
-        for k in ti.static(range(4)):
-            if f[k] < 0.0:
-                inside[k] = 1
-                n_in += 1
-        count = 0
-        ends = ti.Vector.zero(float, 8)
-        if n_in > 0 and n_in < 4:
-            x0 = ti.cast(ti.Vector([i, j]) - cfg.off, float) * cfg.h
-            h = cfg.h
-            corner = [
-                x0,
-                x0 + ti.Vector([h, 0.0]),
-                x0 + ti.Vector([h, h]),
-                x0 + ti.Vector([0.0, h]),
-            ]
-            # crossing on edge k (corner k -> corner k+1), if any
-            cross = ti.Matrix.zero(float, 4, 2)
-            has = ti.Vector([0, 0, 0, 0])
-            for k in ti.static(range(4)):
-                k1 = ti.static((k + 1) % 4)
-                if inside[k] != inside[k1]:
-                    c = _crossing(corner[k], corner[k1], f[k], f[k1])
-                    cross[k, 0] = c[0]
-                    cross[k, 1] = c[1]
-                    has[k] = 1
-            if n_in == 2 and inside[0] == inside[2]:
-                # saddle: cut off the corners whose sign differs from the cell centre
-                centre_in = 1 if f.sum() < 0.0 else 0
-                for k in ti.static(range(4)):
-                    km = ti.static((k + 3) % 4)  # edges adjacent to corner k: km and k
-                    if inside[k] != centre_in:
-                        ends[4 * count + 0] = cross[km, 0]
-                        ends[4 * count + 1] = cross[km, 1]
-                        ends[4 * count + 2] = cross[k, 0]
-                        ends[4 * count + 3] = cross[k, 1]
-                        count += 1
-            else:
-                n = 0
-                for k in ti.static(range(4)):
-                    if has[k] == 1:
-                        ends[2 * n + 0] = cross[k, 0]
-                        ends[2 * n + 1] = cross[k, 1]
-                        n += 1
-                count = 1
+        x0 = ti.cast(ti.Vector([i, j]) - cfg.off, float) * cfg.h
+        count, ends = cell_segments(f, x0, cfg.h)
         seg.ends[i, j] = ends
         seg.count[i, j] = count
 

@@ -12,7 +12,9 @@ Nodes (``nodes``, the grid of ``nx x ny``):
   mass, momentum, force; v_old = v^n and v = v^{n+1}; heat_capacity (eq. 28), capacity_T
   (sum c T), T, heat_rate (eqs. 29-30), dT, deviation and deviation_capacity (the sub-grid
   filter, physics/thermal.py); the CSF method's phi_raw (eq. 21), phi (signed
-  distance), phi_smooth, kappa, scratch, flags (NodeFlag bits) and mass_gradient (eq. 20).
+  distance), phi_smooth, kappa, scratch, flags (NodeFlag bits) and mass_gradient (eq. 20); the
+  surface-energy method's volume (the volume colour), colour (the contoured one) and
+  surface_force (before the mass floor).
 Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, laser_energy,
   heat_out (heat through fixed-temperature walls), T_peak (running maximum), and for each of
   WATCHED the first step at which a point showed it (NEVER if none), so that the guard, which
@@ -92,6 +94,9 @@ NODE_MEMBERS = {
     "scratch": "scalar",
     "flags": "index",
     "mass_gradient": "vector",
+    "volume": "scalar",
+    "colour": "scalar",
+    "surface_force": "vector",
 }
 
 

@@ -7,6 +7,10 @@ length -- the narrowest vertical section of material between the two bodies. It 
 when the pair slides, counts only material (a hole in the neck shortens it) and drops to zero when
 the neck tears. ``neck_span_um`` reports, for the same column, the outer extent from the lowest to
 the highest material (holes included): the silhouette's neck.
+
+The material is {phi < 0} of eq. 21 (the paper's Fig. 4, with the point radius r_p) or
+{c > 1/2} of the surface-energy colour (phi = 1/2 - c; the interface that force moves, no r_p;
+``output.neck_measure``).
 """
 
 from enum import IntEnum

@@ -18,7 +18,7 @@ from .guard import Guard
 from .monitor import body_centroids_x, neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
-from .step import advance, level_set_only
+from .step import advance, colour_only, init_box, level_set_only
 from .step_config import step_config
 from .time_step import resolve_curvature_every, resolve_dt, resolve_heat_every
 
@@ -78,6 +78,7 @@ class Simulation:
         mats = material_arrays(case, self.scene.material_names)
         self.state = State(cfg, self.scene, mats, laser_arrays(case))
         self.state.scalars.dt[None] = self.dt
+        init_box(self.state)
         self.steps = 0
         t0 = time.perf_counter()
         advance(self.state, 0)  # compiles the step kernel
@@ -119,15 +120,35 @@ class Simulation:
         level_set_only(self.state)
         return self.state.nodes.phi.to_numpy()
 
-    def contact_line_m(self) -> tuple[float, float]:
-        """(contact line, neck span) in metres; see :mod:`taichi_sls.solver.monitor`."""
+    def colour(self) -> np.ndarray:
+        """The surface-energy colour c_i of the current points on the nodes (the contoured
+        one: filtered when the case filters it)."""
+        colour_only(self.state)
+        return self.state.nodes.colour.to_numpy()
+
+    def neck_measure(self) -> str:
+        """The interface the contact line is read on: the force's own (``output.neck_measure =
+        "auto"``: the colour for the surface-energy force, eq. 21 for the CSF and for frozen
+        points), or the one the case names."""
+        m = self.case.output.neck_measure
+        if m == "auto":
+            energy = self.case.surface_tension.method == "surface_energy"
+            m = "colour" if energy and self.case.physics.mechanics else "level_set"
+        return m
+
+    def contact_line_m(self, measure: str | None = None) -> tuple[float, float]:
+        """(contact line, neck span) in metres on ``measure`` (default: :meth:`neck_measure`):
+        the narrowest vertical section of material between the two bodies' centroids, on
+        {phi < 0} of eq. 21 or {c > 1/2} of the colour (:mod:`taichi_sls.solver.monitor`)."""
         if not self._pair:
             return float("nan"), float("nan")
         x = self.state.points.x.to_numpy()
         cx = body_centroids_x(x, self.scene.body, self._mass)
         lo, hi = sorted(cx[:2])
         cfg = self.state.cfg
-        return neck_measures(self.phi(), cfg.h, cfg.off, lo, hi)
+        measure = measure or self.neck_measure()
+        field = 0.5 - self.colour() if measure == "colour" else self.phi()
+        return neck_measures(field, cfg.h, cfg.off, lo, hi)
 
     def monitors(self, guard: bool = True) -> dict[str, float]:
         """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard unless
@@ -147,6 +168,8 @@ class Simulation:
         cl, span = self.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6
+        if self.neck_measure() == "colour":  # the paper's measure (Fig. 4) beside it
+            out["contact_line_level_set_um"] = self.contact_line_m("level_set")[0] * 1e6
         if self.steps == 0 and self._H0 is None:
             self._H0 = out["enthalpy_J_per_m"]
         if guard:
@@ -189,6 +212,7 @@ class Simulation:
     def load_checkpoint(self, path: Path) -> dict:
         """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``."""
         self.steps, extra = checkpoint.load(self.state, path, self.case.case.name)
+        init_box(self.state)
         self.dt = float(self.state.scalars.dt[None])
         return extra
 

@@ -1,14 +1,13 @@
 """One explicit MPM step (update-stress-last) as an ordered list of stages, and its layouts.
 
-    active_region  grows to hold every point plus margins; grid loops run over it only
-    clear_grid
+    clear_grid     over the active region (grown at the end of G2P to hold every point)
     p2g            mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; eq. 21**
-    grid_prepare   v^n; node temperature (fixed-temperature walls)*
+    grid_temperature  node temperature (fixed-temperature walls)*
     surface_force  level set and curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
     heat_flux      grad T_p, conduction and laser heat rates (eqs. 29-31)*
     grid_update    v^{n+1} with walls (eq. 13); dT_i*
     g2p            velocity, position, L, F, J (eqs. 14-18); enthalpy, T, xi_s (eqs. 32-33)*;
-                   strain split and Perzyna return map (eqs. 34-45)
+                   strain split and Perzyna return map (eqs. 34-45); the active region grows
     advance_clock  t += dt
 
 ``STAGES`` writes this order once; every layout and the diagnostic kernels run it (or a prefix
@@ -28,7 +27,7 @@ loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
 
 import taichi as ti
 
-from ..physics.codes import Update
+from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
@@ -42,6 +41,7 @@ from ..physics.mechanics import (
     p2g_momentum,
 )
 from ..physics.shape import stencil
+from ..physics.surface_energy import colour_field, scatter_volume, surface_energy_force
 from ..physics.thermal import (
     g2p_heat,
     grid_heat,
@@ -63,18 +63,30 @@ def point_stencil(cfg: ti.template(), pt: ti.template(), p):
 
 
 @ti.func
-def active_region(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    """Grow the active region to hold every point's level-set footprint (5x5 nodes) plus
+def grow_box(st: ti.template(), p):
+    """Grow the active region to hold point p's level-set footprint (5x5 nodes) plus
     ``box_margin`` nodes; grid loops run over it only. It never shrinks, so no node outside it
-    has ever been written: there every field keeps its empty initial value."""
+    has ever been written: there every field keeps its empty initial value. Called where a
+    point has moved (the end of G2P), so that the next step's grid loops cover it."""
     if ti.static(st.cfg.active_region):
         m = ti.static(st.cfg.box_margin)
-        for p in range(st.cfg.n_points):
-            base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
-            ti.atomic_min(st.box[None][0], ti.max(base[0] - 1 - m, 0))
-            ti.atomic_min(st.box[None][1], ti.max(base[1] - 1 - m, 0))
-            ti.atomic_max(st.box[None][2], ti.min(base[0] + 4 + m, st.cfg.nx))
-            ti.atomic_max(st.box[None][3], ti.min(base[1] + 4 + m, st.cfg.ny))
+        base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
+        ti.atomic_min(st.box[None][0], ti.max(base[0] - 1 - m, 0))
+        ti.atomic_min(st.box[None][1], ti.max(base[1] - 1 - m, 0))
+        ti.atomic_max(st.box[None][2], ti.min(base[0] + 4 + m, st.cfg.nx))
+        ti.atomic_max(st.box[None][3], ti.min(base[1] + 4 + m, st.cfg.ny))
+
+
+@ti.func
+def grow_box_all(st: ti.template()):
+    for p in range(st.cfg.n_points):
+        grow_box(st, p)
+
+
+@ti.kernel
+def init_box(st: ti.template()):
+    """The active region of the points as they are (before the first step, after a resume)."""
+    grow_box_all(st)
 
 
 @ti.func
@@ -92,9 +104,19 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
                 if ti.static(st.cfg.subgrid_filter > 0.0):
                     nd.deviation[I] = 0.0
                     nd.deviation_capacity[I] = 0.0
-        if ti.static(st.cfg.surface):
+        if ti.static(_csf(st)):
             if geom:
                 nd.phi_raw[I] = st.cfg.phi_cap
+        if ti.static(_energy(st) and st.cfg.se.volume_colour):
+            nd.volume[I] = 0.0
+
+
+def _csf(st) -> bool:
+    return st.cfg.surface and st.cfg.surface_method == SurfaceMethod.CSF
+
+
+def _energy(st) -> bool:
+    return st.cfg.surface and st.cfg.surface_method == SurfaceMethod.SURFACE_ENERGY
 
 
 @ti.func
@@ -107,24 +129,36 @@ def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
         if ti.static(st.cfg.thermal):
             if heat:
                 p2g_heat_capacity(pt, nd, st.materials, p, base, w, dw)
-        if ti.static(st.cfg.surface):
+        if ti.static(_csf(st)):
             if geom:
                 scatter_level_set(st.cfg, pt, nd, p, base)
+        if ti.static(_energy(st) and st.cfg.se.volume_colour):
+            scatter_volume(st.cfg, pt, nd, p, base, w, dw)
 
 
 @ti.func
-def grid_prepare(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(st.cfg.mech):
-            grid_velocity(st.cfg, st.nodes, I, 0.0)  # v^n only; forces are not complete yet
-        if ti.static(st.cfg.thermal):
+def grid_temperature_stage(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """The node temperatures of a heat step (before the heat flux needs them)."""
+    if ti.static(st.cfg.thermal):
+        if ti.static(isinstance(heat, bool)):
+            if ti.static(heat):
+                _grid_temperature_loop(st)
+        else:
             if heat:
-                grid_temperature(st.cfg, st.nodes, I)
+                _grid_temperature_loop(st)
+
+
+@ti.func
+def _grid_temperature_loop(st: ti.template()):
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        grid_temperature(st.cfg, st.nodes, I)
 
 
 @ti.func
 def surface_force(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    if ti.static(st.cfg.surface):
+    if ti.static(_energy(st)):
+        surface_energy_force(st.cfg, st.box, st.nodes, st.scalars.t[None])
+    if ti.static(_csf(st)):
         if ti.static(isinstance(geom, bool)):
             if ti.static(geom):
                 surface_geometry(st.cfg, st.box, st.nodes, st.surf)
@@ -135,7 +169,7 @@ def surface_force(st: ti.template(), heat: ti.template(), geom: ti.template()):
                 surface_geometry(st.cfg, st.box, st.nodes, st.surf)
             else:
                 mass_gradient(st.cfg, st.box, st.nodes)
-        csf_force(st.cfg, st.box, st.nodes, st.surf)
+        csf_force(st.cfg, st.box, st.nodes, st.surf, st.scalars.t[None])
 
 
 @ti.func
@@ -220,6 +254,8 @@ def g2p(st: ti.template(), heat: ti.template(), geom: ti.template()):
         base, w, dw = point_stencil(st.cfg, pt, p)
         g2p_point(st, p, base, w, dw, dt, not musl, heat)
         watch(st, p)
+        if ti.static(not musl):
+            grow_box(st, p)
     if ti.static(musl and st.cfg.mech):
         for I in ti.grouped(ti.ndrange(*active(st.box))):
             nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
@@ -232,6 +268,7 @@ def g2p(st: ti.template(), heat: ti.template(), geom: ti.template()):
             base, w, dw = point_stencil(st.cfg, pt, p)
             L = g2p_kinematics(st.cfg, pt, nd, p, base, w, dw, dt)
             stress_update(st.cfg, pt, st.materials, p, L, dt)
+            grow_box(st, p)
 
 
 @ti.func
@@ -242,10 +279,9 @@ def advance_clock(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 # The order of one step, written once.
 STAGES = (
-    active_region,
     clear_grid,
     p2g,
-    grid_prepare,
+    grid_temperature_stage,
     surface_force,
     heat_flux,
     grid_update,
@@ -311,13 +347,22 @@ def advance_staged(st: State, n: int) -> None:
 def level_set_only(st: ti.template()):
     """The level set of eq. 21 of the current points, for monitors (also with surface tension
     off). Leaves the curvature the step keeps between rebuilds untouched."""
-    active_region(st, False, True)
+    grow_box_all(st)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         st.nodes.phi_raw[I] = st.cfg.phi_cap
     for p in range(st.cfg.n_points):
         base, w, dw = point_stencil(st.cfg, st.points, p)
         scatter_level_set(st.cfg, st.points, st.nodes, p, base)
     level_set(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.kernel
+def colour_only(st: ti.template()):
+    """The surface-energy colour of the current points (nodes.colour), for monitors: the step's
+    stages up to P2G without heat or geometry, then the colour (filtered as the case says)."""
+    for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
+        stage(st, False, False)
+    colour_field(st.cfg, st.box, st.nodes)
 
 
 @ti.kernel

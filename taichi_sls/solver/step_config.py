@@ -9,11 +9,23 @@ import math
 from dataclasses import dataclass
 
 from ..config import Case
-from ..physics.codes import StressReading, Transfer, Update, WallMechanical
+from ..physics.codes import StressReading, SurfaceMethod, Transfer, Update, WallMechanical
 from ..physics.materials import KELVIN
 from .scene import Scene
 
 T_RUNAWAY_K = 1e4  # no polymer state of this model lives above it (the guard's bound too)
+
+
+@dataclass(frozen=True)
+class SurfaceEnergyConfig:
+    """The switches of the surface-energy force (physics/surface_energy.py)."""
+
+    weight_lp: float  # half-width of the Gauss points' weight (0: the bilinear hat)
+    gauss_points: int
+    floor_mass: float  # kg per depth
+    spread: bool  # hand a light node's rest to its neighbours (else clip)
+    volume_colour: bool
+    filter: bool
 
 
 @dataclass(frozen=True)
@@ -58,10 +70,13 @@ class StepConfig:
     any_fixed: bool
     subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
     # ---- mass and surface tension
+    surface_method: SurfaceMethod
+    se: SurfaceEnergyConfig
     mass_scale: float  # inertia scale s (physics/mechanics.py)
     rho_ref: float  # s times the first body's density: the grid mass of a full cell / V_c
     mass_cut: float
     gamma: float
+    gamma_ramp_s: float  # gamma rises linearly over this time (0: at once)
     r_p: float
     band: int
     redistance: bool
@@ -97,7 +112,11 @@ def step_config(
     h = scene.h
     first = case.materials[case.bodies[0].material]
     surface = ph.surface_tension and ph.mechanics
+    method = SurfaceMethod[st.method.upper()]
+    csf = surface and method == SurfaceMethod.CSF
     thermal = ph.thermal
+    rho_ref = first.density_kg_m3 * sv.mass_scale
+    floor = st.surface_energy_mass_floor * rho_ref * h**2
     return StepConfig(
         dim=2,
         n_points=scene.n_points,
@@ -125,10 +144,13 @@ def step_config(
         update=Update[sv.update.upper()],
         parallel=parallel_layout(case),
         active_region=sv.active_region,
-        # the level-set band and the blur's reach, plus one for the 3x3 fits
-        box_margin=st.band_cells + st.level_set_smoothing_passes + 2 if surface else 0,
+        # CSF: the level-set band and the blur's reach, plus one for the 3x3 fits; surface
+        # energy: the Gauss points of the cells next to the points' nodes
+        box_margin=(st.band_cells + st.level_set_smoothing_passes + 2 if csf else 1)
+        if surface
+        else 0,
         heat_every=heat_every if thermal else 1,
-        geom_every=curvature_every if surface else 1,
+        geom_every=curvature_every if csf else 1,
         wall_mechanical=tuple(WallMechanical[w.mechanical.upper()] for w in walls),
         wall_fixed=tuple(w.thermal == "fixed" for w in walls),
         wall_T=tuple(w.temperature_C + KELVIN for w in walls),
@@ -137,8 +159,20 @@ def step_config(
         subgrid_filter=-math.expm1(-case.thermal.subgrid_filter * dt * heat_every / thermal_limit)
         if thermal
         else 0.0,
+        surface_method=method,
+        se=SurfaceEnergyConfig(
+            weight_lp=h / (2 * case.grid.points_per_cell)
+            if st.surface_energy_weight == "gimp"
+            else 0.0,
+            gauss_points=st.surface_energy_gauss_points,
+            floor_mass=floor,
+            spread=st.surface_energy_floor_mode == "spread" and floor > 0.0,
+            volume_colour=st.surface_energy_colour == "volume",
+            filter=st.surface_energy_colour_filter,
+        ),
+        gamma_ramp_s=st.ramp_s,
         mass_scale=sv.mass_scale,
-        rho_ref=first.density_kg_m3 * sv.mass_scale,
+        rho_ref=rho_ref,
         mass_cut=sv.small_mass * first.density_kg_m3 * sv.mass_scale * h**2,
         gamma=first.surface_tension_N_m,
         r_p=st.point_radius_over_h * h,

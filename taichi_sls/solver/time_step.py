@@ -81,7 +81,7 @@ def resolve_heat_every(case: Case, dt: float, limits: dict[str, float]) -> int:
 def resolve_curvature_every(case: Case, dt: float, limits: dict[str, float]) -> int:
     """Steps between level-set and curvature rebuilds; "auto" keeps the curvature's age at
     ``curvature_step_fraction`` of the capillary limit (paper's fine grid: every 2 steps)."""
-    if "surface_tension" not in limits:
+    if "surface_tension" not in limits or case.surface_tension.method != "csf":
         return 1
     s = case.surface_tension
     lim = limits["surface_tension"]

@@ -26,11 +26,15 @@ def _heat_only(heat_every: int | str, off_s: float = 3.33e-6) -> dict:
 
 
 def test_auto_clocks_on_the_paper_grid():
-    case = make_case(deep_update(PAPER_SCENE, {"time": {"dt_s": 5e-8}}))
+    sets = {"time": {"dt_s": 5e-8}, "surface_tension": {"method": "csf"}}
+    case = make_case(deep_update(PAPER_SCENE, sets))
     dt, lim = resolve_dt(case)
     # thermal limit 9.8e-6 s: 0.1 of it is 19 steps of 5e-8 s; capillary 4.7e-7 s: 0.25 -> 2
     assert resolve_heat_every(case, dt, lim) == int(0.1 * lim["thermal"] / dt) == 19
     assert resolve_curvature_every(case, dt, lim) == 2
+    # the surface-energy force rebuilds its outline every step: no curvature clock
+    energy = make_case(deep_update(PAPER_SCENE, {"time": {"dt_s": 5e-8}}))
+    assert resolve_curvature_every(energy, dt, lim) == 1
 
 
 @pytest.mark.parametrize(

@@ -327,3 +327,65 @@ def test_viscous_decay_rate_from_stokes_modes():
         A, B = np.linalg.solve(M, rhs)
         rate = -n * (A * R ** (n - 1) + B * R ** (n + 1)) / R  # R d eps/dt = u_r(R)
         assert rate == pytest.approx(ref.viscous_decay_rate(n, gamma, eta, R), rel=1e-10)
+
+
+# ---- Hopper's coalescence of two equal cylinders
+
+
+def test_hopper_tau_against_a_direct_quadrature():
+    """tau(nu) integrated in ln m (the module's form) against quad in m itself."""
+    from scipy import integrate, special
+
+    for nu in (0.999, 0.9, 0.5, 0.1, 0.01):
+        q = integrate.quad(
+            lambda x: 1 / (x * math.sqrt(1 + x) * special.ellipk(x)), nu * nu, 1, limit=400
+        )[0]
+        assert ref.hopper_tau(nu) == pytest.approx(math.pi / (2 * math.sqrt(2)) * q, rel=1e-8)
+
+
+@pytest.mark.parametrize("nu", [0.95, 0.69, 0.3, 0.05])
+def test_hopper_outline_keeps_the_area(nu):
+    """Area of the image of the unit circle: 2 pi R0^2 for every nu (the scale c); the neck is
+    the outline's narrowest point on the mid-plane, r_n of hopper_neck."""
+    R0 = 20.0
+    v = ref.hopper_outline(nu, R0, 4000)
+    assert ref.polygon_area(v) == pytest.approx(2 * math.pi * R0**2, rel=2e-5)
+    near = np.abs(v[:, 0]) < 0.05
+    assert np.abs(v[near, 1]).min() == pytest.approx(ref.hopper_neck(nu) * R0, rel=1e-3)
+
+
+def test_hopper_starts_from_two_touching_circles():
+    R0 = 20.0
+    assert ref.hopper_tau(1.0) == 0.0 and ref.hopper_neck(1.0) == 0.0
+    for nu in (1.0, 1 - 1e-7):
+        v = ref.hopper_outline(nu, R0, 2000)
+        d = np.minimum(
+            np.abs(np.hypot(v[:, 0] - R0, v[:, 1]) - R0),
+            np.abs(np.hypot(v[:, 0] + R0, v[:, 1]) - R0),
+        )
+        assert d.max() < 1e-3 * R0
+
+
+def test_hopper_early_time_limit():
+    """nu -> 1: K(m) ~ ln(4 / sqrt(1 - m)) gives tau ~ pi (r_n/R0) / ln(8 R0 / r_n); the ratio
+    tends to 1 with an O(1 / ln) error."""
+    ratios = []
+    for e in (1e-3, 1e-6, 1e-9, 1e-12):
+        rn = ref.hopper_neck(1 - e)
+        ratios.append(ref.hopper_tau(1 - e) / (math.pi * rn / math.log(8 / rn)))
+    assert all(b > a for a, b in zip(ratios[:-1], ratios[1:], strict=True))
+    assert 0.95 < ratios[-1] < 1.0
+
+
+def test_hopper_late_time_limit():
+    """tau -> infinity: r_n -> sqrt(2) R0 (the circle of the pair's area), and nu decays as the
+    n = 2 mode of that circle: d nu / d tau = -nu / sqrt(2), the viscous_decay_rate of R =
+    sqrt(2) R0 in units of gamma / (eta_N R0)."""
+    assert ref.hopper_neck_at(30.0) == pytest.approx(math.sqrt(2), rel=1e-6)
+    a, b = ref.hopper_tau(1e-3), ref.hopper_tau(1e-4)
+    rate = math.log(10) / (b - a)
+    assert rate == pytest.approx(ref.viscous_decay_rate(2, 1.0, 1.0, math.sqrt(2)), rel=1e-6)
+    for tau in (0.3, 1.0, 3.0):
+        assert ref.hopper_tau(ref.hopper_nu(tau)) == pytest.approx(tau, rel=1e-10)
+        assert ref.hopper_tau_at_neck(ref.hopper_neck_at(tau)) == pytest.approx(tau, rel=1e-9)
+    assert ref.hopper_neck_at(1.0) == pytest.approx(0.8258, abs=1e-4)

@@ -112,25 +112,24 @@ def test_gaussian_spreading_2d():
     assert r.errors["peak"] < 0.04
 
 
-def test_viscous_decay_of_a_disc_mode_is_slow_at_coarse_resolution():
-    """R/h = 10: the fitted decay rate of the n = 2 mode against n gamma / (2 eta_N R). The
-    target (3 % at R/h = 20) is missed; this records the coarse-grid bias so that a change in it
-    shows (the study: -37 %, -13 % at R/h = 10, 20, converging)."""
+def test_viscous_decay_of_a_disc_mode_at_coarse_resolution():
+    """R/h = 10: the fitted decay rate of the n = 2 mode against n gamma / (2 eta_N R) (Stokes
+    flow of a disc). Measured with the surface-energy force -15.8 % (the CSF: -38 %); -5.0 %
+    and -1.5 % at R/h = 20 and 40 (docs/verification.md). Tolerance: 20 % at R/h = 10, the
+    coarse grid's bias; the convergence is the slow study's."""
     r = ver.run(ver.load("viscous_decay", 10, {"time": {"end_s": 6e-5}}))
     print("viscous decay, R/h = 10:", r.errors, r.info)
-    # measured -0.37 (rate 3.8e3 1/s against 6.05e3). Tolerance: the decay is slower than the
-    # reference by 25-50 % (a fitted rate, the log-linear fit over 6e-5 s is exact for a pure
-    # exponential)
-    assert -0.5 < r.errors["decay_rate"] < -0.25
+    assert abs(r.errors["decay_rate"]) < 0.2
     assert r.info["rate_1_s"] > 0
 
 
 def test_inviscid_disc_oscillates_near_the_rayleigh_period():
     r = ver.run(ver.load("inviscid", 10))
     print("inviscid period, R/h = 10:", r.errors, r.info)
-    # measured +0.26 at R/h = 10 (+0.097 at 20). Tolerance: it oscillates (two zero crossings,
-    # the runner raises otherwise) with a period within 35 % of 2 pi / omega
-    assert abs(r.errors["period"]) < 0.35
+    # measured with the surface-energy force +1.8 % at R/h = 10 (+0.8 % at 20; the CSF: +26 %,
+    # +9.7 %). Tolerance: it oscillates (two zero crossings, the runner raises otherwise) with a
+    # period within 5 % of 2 pi / omega at this coarse grid
+    assert abs(r.errors["period"]) < 0.05
 
 
 @pytest.mark.slow

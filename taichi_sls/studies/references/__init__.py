@@ -9,11 +9,13 @@ input and ``numpy.ndarray`` otherwise.
 - :mod:`.heat`: erf half-space, spreading 2D Gaussian;
 - :mod:`.perzyna`: Perzyna overstress viscoplasticity;
 - :mod:`.stefan`: Stefan melting with a linear mushy zone;
-- :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc.
+- :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc;
+- :mod:`.hopper`: the coalescence of two equal viscous cylinders (Hopper 1984, 1990).
 """
 
 from .capillarity import *  # noqa: F403
 from .heat import *  # noqa: F403
+from .hopper import *  # noqa: F403
 from .mechanics import *  # noqa: F403
 from .perzyna import *  # noqa: F403
 from .stefan import *  # noqa: F403

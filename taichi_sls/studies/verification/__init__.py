@@ -19,6 +19,7 @@ from .capillarity import (
 )
 from .common import Result
 from .heat import run_energy, run_erf, run_gaussian, run_stefan
+from .hopper import run_hopper
 from .mechanics import perzyna_history, run_bar, run_perzyna, run_steffen
 from .spec import VerificationCase, case_names, case_path, load, load_file
 
@@ -35,6 +36,7 @@ RUNNERS: dict[str, Callable[[VerificationCase], Result]] = {
     "square": run_square,
     "viscous_decay": run_viscous_decay,
     "inviscid": run_inviscid,
+    "hopper": run_hopper,
 }
 
 __all__ = [

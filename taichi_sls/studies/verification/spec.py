@@ -6,14 +6,13 @@ data before the case is validated. Resolution parameter of :func:`load`, by kind
 - ``bar``, ``steffen``: cells along the bar (the cross-section is one cell of points);
 - ``stefan``: cells across the melt depth X_m at the end time (the slab is 5 X_m long);
 - ``curvature``, ``laplace``, ``viscous_decay``, ``inviscid``: R/h of the disc;
-- ``hopper``, ``hopper_shape``: R0/h of each cylinder;
+- ``hopper``: R0/h of each cylinder (touching discs, or Hopper's outline at hopper_tau0);
 - ``perzyna``: time steps over the constant-rate drive;
 - every other kind: the grid spacing in um.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -22,9 +21,10 @@ from pydantic import Field, ValidationError
 
 from ...config import Case, CaseError, bundled_cases, case_from_dict, deep_update, read_toml
 from ...config.errors import case_error
-from ...config.loading import bundled_root, find_case
+from ...config.loading import bundled_root, find_case, resolve_files
 from ...config.model import Model, Pair
 from .. import references as ref
+from .geometry import bar_geometry, disc_geometry, hopper_geometry, slab_length
 
 Kind = Literal[
     "none",
@@ -40,6 +40,7 @@ Kind = Literal[
     "square",
     "viscous_decay",
     "inviscid",
+    "hopper",
 ]
 
 
@@ -72,6 +73,24 @@ class VerificationSpec(Model):
     )
     hold_strain: float = Field(
         0.0, ge=0, description="perzyna: shear strain eps_xy held fixed for the relaxation check"
+    )
+    hopper_tau0: float = Field(
+        0.0,
+        ge=0,
+        description="hopper: 0: the run starts from two touching discs and its clock is aligned "
+        "where the neck first reaches hopper_align; > 0: it starts from Hopper's exact outline "
+        "at this tau = gamma t / (eta_N R0) (a polygon body)",
+    )
+    hopper_align: float = Field(
+        0.35, gt=0, lt=1.4, description="hopper from touching discs: r_n / R0 where clocks align"
+    )
+    hopper_taus: list[float] = Field(
+        [0.5, 1.0, 2.0, 3.0], description="hopper: the tau at which r_n / R0 is compared"
+    )
+    hopper_midplane: Literal["node", "cell"] = Field(
+        "node",
+        description="hopper at a resolution (verification.load): the mid-plane on a node line "
+        "or through cell centres",
     )
 
 
@@ -146,6 +165,7 @@ def load_file(path: str | Path, overrides: list[str] | None = None) -> Verificat
     for o in overrides or []:
         apply_override(data, o)
     data.setdefault("case", {}).setdefault("name", path.stem)
+    resolve_files(data, path.parent)
     return from_dict(data)
 
 
@@ -158,36 +178,6 @@ def case_path(name: str) -> Path:
 
 def case_names() -> list[str]:
     return [p.stem for p in bundled_cases("verification")]
-
-
-def _disc_geometry(data: dict, R_over_h: float) -> None:
-    """Disc of the case at R/h: domain 2R(1 + |eps|) + 12 h square, centre off the grid lines so
-    that the seeding is not symmetric about a node."""
-    b = data["bodies"][0]
-    R = b["radius_um"]
-    h = R / R_over_h
-    W = h * math.ceil((2 * R * (1 + abs(b.get("perturbation", 0.0))) + 12 * h) / h)
-    data["grid"]["spacing_um"] = h
-    data["domain"] = {"width_um": W, "height_um": W}
-    b["center_um"] = [W / 2 + 0.123 * h, W / 2 + 0.377 * h]
-
-
-def _bar_geometry(data: dict, cells: int, fixed_fixed: bool) -> None:
-    b = data["bodies"][0]
-    L = b["max_um"][0]
-    h = L / cells
-    data["grid"]["spacing_um"] = h
-    data["domain"] = {"width_um": L if fixed_fixed else L + 4 * h, "height_um": 4 * h}
-    b["max_um"] = [L, h]
-
-
-def _slab_length(data: dict, h: float, length: float) -> None:
-    """A 1D slab along x: `length` rounded up to whole cells, two cells of points tall."""
-    W = h * math.ceil(length / h - 1e-9)
-    data["grid"]["spacing_um"] = h
-    data["domain"] = {"width_um": W, "height_um": 4 * h}
-    data["bodies"][0]["min_um"] = [0.0, 0.0]
-    data["bodies"][0]["max_um"] = [W, 2 * h]
 
 
 def stefan_slab(case: Case) -> ref.StefanSlab:
@@ -220,18 +210,21 @@ def load(name: str, resolution: float | None = None, sets: dict | None = None) -
         )
     data = deep_update(read_toml(path, "verification case"), sets or {})
     data.setdefault("case", {}).setdefault("name", name)
+    resolve_files(data, path.parent)
     data.setdefault("grid", {})
     kind = data.get("verification", {}).get("kind", "none")
     if resolution is not None:
         if kind in ("bar", "steffen"):
-            _bar_geometry(data, int(resolution), kind == "steffen")
+            bar_geometry(data, int(resolution), kind == "steffen")
         elif kind in ("curvature", "laplace", "viscous_decay", "inviscid"):
-            _disc_geometry(data, float(resolution))
+            disc_geometry(data, float(resolution))
         elif kind == "stefan":
             Xm = stefan_melt_depth_um(from_dict(data).case)
-            _slab_length(data, Xm / float(resolution), 5.0 * Xm)
+            slab_length(data, Xm / float(resolution), 5.0 * Xm)
         elif kind == "erf":
-            _slab_length(data, float(resolution), data["domain"]["width_um"])
+            slab_length(data, float(resolution), data["domain"]["width_um"])
+        elif kind == "hopper":
+            hopper_geometry(data, float(resolution))
         elif kind == "perzyna":
             data.setdefault("time", {})["dt_s"] = data["time"]["end_s"] / int(resolution)
             data["time"]["allow_unstable_dt"] = True  # a point-level drive: no grid limit

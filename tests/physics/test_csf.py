@@ -1,5 +1,6 @@
-"""Surface tension: curvature from points, Laplace pressure, a square relaxing to a disc, and the
-contact-line measure."""
+"""The paper's surface tension (``surface_tension.method = "csf"``): curvature from points, the
+Laplace pressure, a square relaxing to a disc; the contact-line measure; the discs' equilibrium
+start; the nolaser pair."""
 
 import numpy as np
 import pytest
@@ -8,6 +9,8 @@ from helpers import PAPER_SCENE, deep_update, make_case
 from taichi_sls.config import load_case
 from taichi_sls.solver.monitor import column_material_length, neck_measures
 from taichi_sls.solver.simulation import Simulation
+
+CSF = {"surface_tension": {"method": "csf"}}
 from taichi_sls.studies import verification as ver
 
 
@@ -15,7 +18,7 @@ def disc_curvature_error(R: float, h: float, **surface) -> tuple[float, float]:
     """(mean, RMS) relative curvature error over the interface nodes of a disc of points
     (cases/verification/curvature.toml with radius R and spacing h)."""
     body = {"shape": "disc", "radius_um": R, "center_um": [0.0, 0.0]}  # centred by the loader
-    sets = {"bodies": [body], "surface_tension": surface}
+    sets = {"bodies": [body], "surface_tension": {"method": "csf", **surface}}
     e = ver.run(ver.load("curvature", R / h, sets)).errors
     return e["curvature_mean"], e["curvature_rms"]
 
@@ -54,7 +57,7 @@ def test_laplace_pressure_of_a_static_disc():
     """A disc of Maxwell fluid at rest under surface tension carries the mean in-plane pressure
     gamma / R (2D Laplace law; cases/verification/laplace.toml at R/h = 10); the spurious
     velocities that remain are reported and bounded."""
-    r = ver.run(ver.load("laplace", 10))
+    r = ver.run(ver.load("laplace", 10, CSF))
     print("Laplace, R/h = 10:", r.errors, r.info)
     # measured: pressure -1.1 %, |v|max 4.5e-3 m/s = 3.4e-3 of the capillary velocity
     # sqrt(gamma / rho R), capillary number eta_N |v| / gamma = 0.037 (the issue's 1e-3 is
@@ -67,7 +70,7 @@ def test_laplace_pressure_of_a_static_disc():
 def test_square_relaxes_towards_a_disc():
     """A square of soft, low-viscosity Maxwell fluid (cases/verification/square.toml) rounds off
     under surface tension, keeping its area."""
-    r = ver.run(ver.load("square", 2.0))
+    r = ver.run(ver.load("square", 2.0, CSF))
     print("square:", r.errors, r.info)
     # measured: n = 4 amplitude 0.47 of its start after 300 us (0.92 at h = 4 um), area +1.0 %.
     # Tolerance: the amplitude falls below 0.6 of its start; the area (nearly incompressible)
@@ -101,9 +104,10 @@ def test_contact_line_on_constructed_shapes():
 
 
 def test_paper_scene_starts_near_8um():
-    sim = Simulation(make_case(deep_update(PAPER_SCENE, {"physics": {"thermal": False}})))
+    """The level set of eq. 21 (r_p = 0.375 h) reads the paper's Fig. 4a: 8 um."""
+    sim = Simulation(make_case(deep_update(PAPER_SCENE, {"physics": {"thermal": False}, **CSF})))
     cl = sim.monitors()["contact_line_um"]
-    assert 7.5 < cl < 9.0  # the paper's Fig. 4a: 8 um
+    assert 7.5 < cl < 9.0
 
 
 def test_neck_span_counts_holes():
@@ -126,7 +130,7 @@ def _floating_disc(initial_stress: str):
             "domain": {"width_um": 60.0, "height_um": 60.0},
             "bodies": [{"center_um": [30.0, 30.0], "radius_um": 20.0}],
             "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0]},
-            "surface_tension": {"initial_stress": initial_stress},
+            "surface_tension": {"initial_stress": initial_stress, "method": "csf"},
             "time": {"dt_s": 5e-8, "end_s": 4e-5},
         }
     )
@@ -175,10 +179,10 @@ def test_laplace_initial_stress_keeps_a_disc_at_rest():
 
 
 def test_nolaser_neck_holds_and_kinetic_energy_decays():
-    """Issue #4's laser-off check on the paper's fine scene (cases/nolaser.toml, 1 ms): the
+    """Issue #4's laser-off check with the paper's force (cases/nolaser.toml, 1 ms): the
     contact line stays within 2 % of its start (measured: 8.27 -> 8.27-8.40 um) and the kinetic
     energy does not grow from noise (measured: 3.1e-10 J/m at 0.1 ms, 3.9e-13 J/m at 1 ms)."""
-    sim = Simulation(load_case("nolaser"))
+    sim = Simulation(load_case("nolaser", ["surface_tension.method=csf"]))
     n = round(1e-4 / sim.dt)
     m0 = sim.monitors()
     lines, ke = [], []

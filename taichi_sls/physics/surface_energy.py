@@ -1,0 +1,165 @@
+"""Surface tension as the gradient of the surface energy (``surface_tension.method =
+"surface_energy"``; Hyde, Gagniere, Marquez-Razon & Teran 2020, in 2D).
+
+The surface energy of the bodies is gamma times the length of their outline. On the grid:
+
+1. **Colour** c_i = m_i / (rho V_c) from the node mass of the P2G (``surface_energy_colour =
+   "mass"``), or c_i = sum_p V_p N_i(x_p) / V_c (``"volume"``). Every point adds to it, whatever
+   its body: touching bodies share one colour field and so one outline, and they merge. With
+   ``surface_energy_colour_filter`` the contoured colour is c after one [1 2 1]/4 pass along x
+   and y: a pair whose mid-plane lies on a node line (the paper's) otherwise keeps a one-cell
+   notch at the neck, since the points of the two bodies never cross it.
+2. **Outline**: the c = 1/2 contour, cell by cell by marching squares (physics/contour.py).
+3. **Force**: the perimeter's rate of change under the grid velocity v = sum_i v_i N_i is
+   dL/dt = sum_i v_i . sum_q L_q (I - n_q n_q) grad N_i(x_q) (the tangential divergence of v
+   along the outline), so the force that lowers gamma L is
+
+       f_i = -gamma sum_q w_q L_q (I - n_q n_q^T) grad N_i(x_q)
+
+   over the Gauss points x_q of the segments (``surface_energy_gauss_points``, weights w_q). No
+   curvature appears: nothing to smooth or cap, and a concave cusp gets its full pull. grad N is
+   the bilinear hat's (``surface_energy_weight = "hat"``: the segment's cell corners; linear
+   along a straight segment, so one Gauss point is exact) or the solver's uGIMP (``"gimp"``).
+   Both reproduce constants and linear fields, so every segment's forces have no resultant and
+   no torque.
+4. **Mass floor**: nodes at the edge of the points' support hold almost no mass but receive
+   force from nearby Gauss points; their acceleration f_i / m_i is unbounded. A node below
+   m_floor = ``surface_energy_mass_floor`` rho V_c keeps m_i / m_floor of its surface force and
+   hands the rest to its 3x3 neighbours in proportion to their mass (``floor_mode = "spread"``,
+   momentum kept) or drops it (``"clip"``). The other forces are untouched.
+
+Arguments: ``cfg`` (its ``se`` holds this method's switches), ``box`` the active region, ``nd``
+the nodes (``mass``, ``volume``, ``colour``, ``surface_force``, and ``force`` that it adds to).
+"""
+
+import math
+
+import taichi as ti
+
+from .contour import cell_segments
+from .grid import active, ramped_gamma
+from .shape import STENCIL, node_weight, stencil
+
+C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
+
+# Gauss-Legendre points on [0, 1] and weights (summing to 1), by number of points
+GAUSS = {
+    1: ((0.5,), (1.0,)),
+    2: ((0.5 - 0.5 / math.sqrt(3.0), 0.5 + 0.5 / math.sqrt(3.0)), (0.5, 0.5)),
+    3: (
+        (0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6)),
+        (5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0),
+    ),
+}
+
+
+@ti.func
+def scatter_volume(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
+    """Volume colour: V_p N_i(x_p) onto the 3x3 nodes of point p (in the P2G loop)."""
+    Vp = pt.volume0[p] * pt.J[p]
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        nd.volume[base + o] += N * Vp
+
+
+@ti.func
+def raw_colour(cfg: ti.template(), nd: ti.template(), I):
+    """c_i: the fraction of node i's cell that material fills."""
+    c = 0.0
+    if ti.static(cfg.se.volume_colour):
+        c = nd.volume[I] / cfg.cell_volume
+    else:
+        c = nd.mass[I] / (cfg.rho_ref * cfg.cell_volume)
+    return c
+
+
+@ti.func
+def colour_field(cfg: ti.template(), box: ti.template(), nd: ti.template()):
+    """nd.colour: the colour that is contoured, c_i or its [1 2 1]/4 filter along x and y."""
+    for i, j in ti.ndrange(*active(box)):
+        c = 0.0
+        if ti.static(cfg.se.filter):
+            if i > 0 and j > 0 and i < cfg.nx - 1 and j < cfg.ny - 1:
+                for a, b in ti.static(ti.ndrange(3, 3)):
+                    wa = ti.static((0.25, 0.5, 0.25)[a] * (0.25, 0.5, 0.25)[b])
+                    c += wa * raw_colour(cfg, nd, ti.Vector([i + a - 1, j + b - 1]))
+        else:
+            c = raw_colour(cfg, nd, ti.Vector([i, j]))
+        nd.colour[i, j] = c
+
+
+@ti.func
+def segment_force(cfg: ti.template(), nd: ti.template(), a, b, gamma):
+    """f_i += -gamma w_q L t (t . grad N_i(x_q)) over the Gauss points of segment a-b
+    (I - n n^T = t t^T in 2D); below the floor, the node's share as the floor mode says."""
+    d = b - a
+    L = d.norm()
+    if L > 0.0:
+        t = d / L
+        s, wq = ti.static(GAUSS[cfg.se.gauss_points])
+        for q in ti.static(range(len(s))):
+            xq = a + s[q] * d
+            base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
+            for o in ti.static(ti.grouped(STENCIL)):
+                N, gN = node_weight(w, dw, o)
+                I = base + o
+                tg = t.dot(gN)
+                if tg != 0.0:
+                    if ti.static(cfg.se.spread):
+                        nd.surface_force[I] += (-gamma * wq[q] * L * tg) * t
+                    elif ti.static(cfg.se.floor_mass > 0.0):
+                        m = nd.mass[I]
+                        scale = m / ti.max(m, cfg.se.floor_mass)
+                        nd.force[I] += (-gamma * wq[q] * L * tg * scale) * t
+                    else:
+                        nd.force[I] += (-gamma * wq[q] * L * tg) * t
+
+
+@ti.func
+def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()):
+    """floor_mode = "spread": node i keeps m_i / max(m_i, floor) of its surface force and hands
+    the rest to its 3x3 neighbours in proportion to their mass. The total force is kept
+    (momentum); the torque changes by the rest times at most sqrt(2) h."""
+    for I in ti.grouped(ti.ndrange(*active(box))):
+        f = nd.surface_force[I]
+        m = nd.mass[I]
+        if m >= cfg.se.floor_mass:
+            nd.force[I] += f
+        elif f.norm_sqr() > 0.0:
+            M = 0.0
+            for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
+                if ti.static(o[0] != 0 or o[1] != 0):
+                    M += nd.mass[I + o]
+            keep = m / cfg.se.floor_mass
+            if M <= 0.0:
+                keep = 1.0
+            nd.force[I] += keep * f
+            if M > 0.0:
+                rest = (1.0 - keep) / M * f
+                for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
+                    if ti.static(o[0] != 0 or o[1] != 0):
+                        nd.force[I + o] += nd.mass[I + o] * rest
+
+
+@ti.func
+def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), t):
+    """The outline of the colour field and its surface-energy force, added to nd.force."""
+    if ti.static(cfg.se.spread):
+        for I in ti.grouped(ti.ndrange(*active(box))):
+            nd.surface_force[I] = ti.Vector.zero(float, 2)
+    colour_field(cfg, box, nd)
+    gamma = ramped_gamma(cfg, t)
+    for i, j in ti.ndrange(*active(box, 1)):
+        if i > 0 and j > 0 and i < cfg.nx - 2 and j < cfg.ny - 2:
+            f = C_INTERFACE - ti.Vector(
+                [nd.colour[i, j], nd.colour[i + 1, j], nd.colour[i + 1, j + 1], nd.colour[i, j + 1]]
+            )
+            if f.max() >= 0.0 and f.min() < 0.0:
+                x0 = ti.cast(ti.Vector([i, j]) - cfg.off, float) * cfg.h
+                count, ends = cell_segments(f, x0, cfg.h)
+                for k in range(count):
+                    a = ti.Vector([ends[4 * k], ends[4 * k + 1]])
+                    b = ti.Vector([ends[4 * k + 2], ends[4 * k + 3]])
+                    segment_force(cfg, nd, a, b, gamma)
+    if ti.static(cfg.se.spread):
+        spread_light_nodes(cfg, box, nd)
