@@ -9,9 +9,9 @@ from helpers import PAPER_SCENE, deep_update, make_case
 from taichi_sls.config import load_case
 from taichi_sls.solver.monitor import column_material_length, neck_measures
 from taichi_sls.solver.simulation import Simulation
+from taichi_sls.studies import verification as ver
 
 CSF = {"surface_tension": {"method": "csf"}}
-from taichi_sls.studies import verification as ver
 
 
 def disc_curvature_error(R: float, h: float, **surface) -> tuple[float, float]:
