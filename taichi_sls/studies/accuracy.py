@@ -35,6 +35,7 @@ COLUMNS = (
     "steps",
     "transfer",
     "precision",
+    "method",
 )
 TRANSFERS = {
     "apic": {"transfer": "apic"},
@@ -55,6 +56,12 @@ class Study:
     sets: dict = field(default_factory=dict)
     transfers_at: tuple[float, ...] = ()
     f32_at: tuple[float, ...] = ()
+    csf_at: tuple[float, ...] = ()  # capillary cases: the paper's CSF beside the default force
+    case: str = ""  # the verification case file (default: the name)
+
+    @property
+    def file(self) -> str:
+        return self.case or self.name
 
 
 # Resolutions: the coarse end that keeps the full study under ~25 minutes on two cores.
@@ -75,8 +82,8 @@ STUDIES = (
     Study("stefan", (25, 50, 100), (25,), "melt_front"),
     Study("energy", (4.0, 2.0), (4.0,), "energy_balance", f32_at=(4.0,)),
     Study("curvature", (10, 20, 40), (10, 20), "curvature_mean"),
-    Study("laplace", (10, 20, 40), (10,), "pressure"),
-    Study("square", (4.0, 2.0, 1.0), (4.0,), "mode4_left"),
+    Study("laplace", (10, 20, 40), (10,), "pressure", csf_at=(10, 20, 40)),
+    Study("square", (4.0, 2.0, 1.0), (4.0,), "mode4_left", csf_at=(4.0, 2.0, 1.0)),
     Study(
         "viscous_decay",
         (10, 20, 40),
@@ -84,8 +91,27 @@ STUDIES = (
         "decay_rate",
         sets={"time": {"end_s": 6e-5}},
         transfers_at=(20,),
+        csf_at=(10, 20, 40),
     ),
-    Study("inviscid", (10, 20, 40), (10,), "period", transfers_at=(20,), f32_at=(20,)),
+    Study(
+        "inviscid",
+        (10, 20, 40),
+        (10,),
+        "period",
+        transfers_at=(20,),
+        f32_at=(20,),
+        csf_at=(10, 20, 40),
+    ),
+    Study("hopper", (10, 20, 40), (10,), "neck_tau1", csf_at=(10,)),
+    Study(
+        "hopper_cell",
+        (10, 20),
+        (),
+        "neck_tau1",
+        sets={"verification": {"hopper_midplane": "cell"}},
+        case="hopper",
+    ),
+    Study("hopper_shape", (10, 20), (), "neck_tau1"),
 )
 
 
@@ -102,6 +128,7 @@ def _row(s: Study, kind: str, res: float, r: ver.Result, measure: str, error: fl
         "steps": r.steps,
         "transfer": r.transfer,
         "precision": r.precision,
+        "method": r.method,
     }
 
 
@@ -116,18 +143,19 @@ def run_study(quick: bool, out: Path, only: list[str] | None = None) -> list[dic
         for s in STUDIES:
             if only and s.name not in only:
                 continue
-            kind = ver.load(s.name).spec.kind
+            kind = ver.load(s.file).spec.kind
             res_list = s.quick if quick else s.resolutions
             jobs: list[tuple[float, dict]] = [(r, {}) for r in res_list]
             if not quick:
-                own = transfer_label(ver.load(s.name).case)
+                own = transfer_label(ver.load(s.file).case)
                 for r in s.transfers_at:
                     jobs += [(r, {"solver": t}) for k, t in TRANSFERS.items() if k != own]
                 jobs += [(r, {"solver": {"precision": "f32"}}) for r in s.f32_at]
+                jobs += [(r, {"surface_tension": {"method": "csf"}}) for r in s.csf_at]
             for res, extra in jobs:
                 sets = deep_update(s.sets, extra)
                 try:
-                    r = ver.run(ver.load(s.name, res, sets))
+                    r = ver.run(ver.load(s.file, res, sets))
                 except Exception as e:  # a failing case is a row, never the end of the study
                     print(f"{s.name} at {res}: {type(e).__name__}: {e}", file=sys.stderr)
                     continue

@@ -10,7 +10,16 @@ from . import verification as ver
 from .verification.common import transfer_label
 
 
-def _series(rows: list[dict], case: str, measure: str, transfer: str | None, precision: str):
+def _series(
+    rows: list[dict],
+    case: str,
+    measure: str,
+    transfer: str | None,
+    precision: str,
+    method: str | None = None,
+):
+    """The rows of one line: a case's measure at one transfer, precision and capillary method
+    (None: any)."""
     pts = [
         r
         for r in rows
@@ -18,6 +27,7 @@ def _series(rows: list[dict], case: str, measure: str, transfer: str | None, pre
         and r["measure"] == measure
         and r["precision"] == precision
         and (transfer is None or r["transfer"] == transfer)
+        and (method is None or r.get("method", "") == method)
     ]
     return sorted(pts, key=lambda r: -float(r["h_um"]) if case != "perzyna" else -float(r["dt_s"]))
 
@@ -34,9 +44,10 @@ def observed_orders(hs: list[float], errs: list[float]) -> list[float]:
     return out
 
 
-def _default_transfer(rows: list[dict], case: str) -> str:
-    """The transfer label of the case file's own solver settings."""
-    return transfer_label(ver.load(case).case)
+def _own(s) -> tuple[str, str]:
+    """(transfer label, capillary method) of a study's case file as it stands."""
+    case = ver.load(s.file).case
+    return transfer_label(case), case.surface_tension.method if case.physics.surface_tension else ""
 
 
 def _error_line(ax, pts: list[dict], fmt: str, **kw) -> None:
@@ -72,7 +83,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
     cols = 4
     fig, axes = plt.subplots(math.ceil(n / cols), cols, figsize=(13, 2.8 * math.ceil(n / cols)))
     for ax, s in zip(axes.flat, cases, strict=False):
-        pts = _series(rows, s.name, s.measure, _default_transfer(rows, s.name), "f64")
+        pts = _series(rows, s.name, s.measure, *_own(s)[:1], "f64", _own(s)[1])
         x = [float(r["dt_s"] if s.name == "perzyna" else r["h_um"]) for r in pts]
         e = [abs(float(r["error"])) for r in pts]
         ax.loglog(x, e, "o-")
@@ -93,7 +104,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for i, s in enumerate(cases):
-        pts = _series(rows, s.name, s.measure, _default_transfer(rows, s.name), "f64")
+        pts = _series(rows, s.name, s.measure, _own(s)[0], "f64", _own(s)[1])
         t = [float(r["wall_s"]) for r in pts]
         e = [max(abs(float(r["error"])), 1e-16) for r in pts]
         ax.loglog(t, e, marker="o", label=s.name, color=f"C{i % 10}", ls="-" if i < 10 else "--")
@@ -111,7 +122,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
         fig, axes = plt.subplots(1, len(prec), figsize=(3.2 * len(prec), 3), squeeze=False)
         for ax, s in zip(axes.flat, prec, strict=False):
             for p, mk in (("f64", "o-"), ("f32", "s--")):
-                pts = _series(rows, s.name, s.measure, _default_transfer(rows, s.name), p)
+                pts = _series(rows, s.name, s.measure, _own(s)[0], p, _own(s)[1])
                 hs = {float(r["h_um"]) for r in _series(rows, s.name, s.measure, None, "f32")}
                 pts = [r for r in pts if float(r["h_um"]) in hs]
                 _error_line(ax, pts, mk, label=p)
@@ -129,7 +140,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
             for i, t in enumerate(transfers):
                 pts = [
                     r
-                    for r in _series(rows, s.name, s.measure, t, "f64")
+                    for r in _series(rows, s.name, s.measure, t, "f64", _own(s)[1])
                     if float(r["resolution"]) in s.transfers_at
                 ]
                 _error_line(ax, pts, "o-", label=t, color=f"C{i}")
@@ -137,22 +148,45 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
         made.append(
             _save(fig, "Transfers: APIC, FLIP, PIC/FLIP 0.9", out / "accuracy_transfer.png")
         )
+
+    methods = [s for s in cases if s.csf_at]
+    if methods:
+        fig, axes = plt.subplots(1, len(methods), figsize=(3.3 * len(methods), 3), squeeze=False)
+        for ax, s in zip(axes.flat, methods, strict=False):
+            for i, m in enumerate(("surface_energy", "csf")):
+                pts = _series(rows, s.name, s.measure, _own(s)[0], "f64", m)
+                _error_line(ax, pts, "o-" if i == 0 else "s--", label=m, color=f"C{i}")
+            _panel_labels(ax, s)
+        made.append(
+            _save(
+                fig,
+                "Capillary force: surface energy against the paper's CSF",
+                out / "accuracy_methods.png",
+            )
+        )
     return made
 
 
 def summary_table(rows: list[dict], studies: tuple) -> str:
     """Markdown: per case and measure (default transfer, f64), errors at each resolution and the
     observed orders."""
-    lines = ["| case | measure | resolution: error | observed orders |", "|---|---|---|---|"]
+    lines = [
+        "| case | measure | method | resolution: error | observed orders |",
+        "|---|---|---|---|---|",
+    ]
     for s in studies:
         measures = dict.fromkeys(r["measure"] for r in rows if r["case"] == s.name)
+        transfer, own = _own(s)
         for m in measures:
-            pts = _series(rows, s.name, m, _default_transfer(rows, s.name), "f64")
-            if not pts:
-                continue
-            x = [float(r["dt_s"] if s.name == "perzyna" else r["h_um"]) for r in pts]
-            e = [float(r["error"]) for r in pts]
-            cells = ", ".join(f"{float(r['resolution']):g}: {float(r['error']):+.2e}" for r in pts)
-            orders = ", ".join(f"{p:.2f}" for p in observed_orders(x, e))
-            lines.append(f"| {s.name} | {m} | {cells} | {orders} |")
+            for method in dict.fromkeys([own, *(["csf"] if s.csf_at else [])]):
+                pts = _series(rows, s.name, m, transfer, "f64", method)
+                if not pts:
+                    continue
+                x = [float(r["dt_s"] if s.name == "perzyna" else r["h_um"]) for r in pts]
+                e = [float(r["error"]) for r in pts]
+                cells = ", ".join(
+                    f"{float(r['resolution']):g}: {float(r['error']):+.2e}" for r in pts
+                )
+                orders = ", ".join(f"{p:.2f}" for p in observed_orders(x, e))
+                lines.append(f"| {s.name} | {m} | {method or '-'} | {cells} | {orders} |")
     return "\n".join(lines) + "\n"

@@ -24,6 +24,7 @@ class Result:
     transfer: str
     precision: str
     info: dict[str, float] = field(default_factory=dict)
+    method: str = ""  # the capillary force, where surface tension is on
 
 
 def material(case: Case) -> Material:
@@ -41,6 +42,7 @@ def result(case: Case, sim, errors: dict[str, float], t0: float, **info: float) 
         transfer=transfer_label(case),
         precision=case.solver.precision,
         info=dict(info),
+        method=case.surface_tension.method if case.physics.surface_tension else "",
     )
 
 
