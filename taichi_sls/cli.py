@@ -126,7 +126,7 @@ def case_command(args: argparse.Namespace) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    from .studies import accuracy, neck_study, paper, robustness, speed
+    from .studies import accuracy, cost_error, neck_study, paper, robustness, speed
     from .studies.sweep import runner as sweep
 
     ap = argparse.ArgumentParser(
@@ -137,9 +137,11 @@ def parser() -> argparse.ArgumentParser:
     add_run_arguments(p)
     p.set_defaults(func=run_command)
     sweep.add_parser(sub)
-    bench = sub.add_parser("bench", help="benchmarks and studies: speed, accuracy, paper, neck")
+    bench = sub.add_parser(
+        "bench", help="benchmarks and studies: speed, cost, accuracy, paper, neck"
+    )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
-    for module in (speed, accuracy, paper, neck_study):
+    for module in (speed, cost_error, accuracy, paper, neck_study):
         module.add_parser(studies)
     robustness.add_parser(sub)
     p = sub.add_parser("case", help="print the case-file reference (every key, default, unit)")

@@ -112,6 +112,11 @@ class Case(Model):
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+        if self.solver.stress_reading == "paper" and self.solver.stress_form != "total":
+            raise CaseError(
+                f"solver.stress_form = {self.solver.stress_form!r}: the printed eq. 39 "
+                '(solver.stress_reading = "paper") exists in the total form only'
+            )
         if self.time.stop == "solidified" and self.time.max_s <= self.lasers_off_s():
             raise CaseError(
                 f"time.max_s = {self.time.max_s}: must exceed the time every laser is off "

@@ -171,7 +171,14 @@ class Solver(Model):
     stress_reading: Literal["model", "paper"] = Field(
         "model",
         description="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md); paper: eq. 39 "
-        "and p = lambda tr(eps) as printed",
+        'and p = lambda tr(eps) as printed (with stress_form = "total")',
+    )
+    stress_form: Literal["incremental", "total"] = Field(
+        "incremental",
+        description="total: the stress from the accumulated elastic strain at the current "
+        "moduli (eqs. 38-39: a melt that freezes, E rising tenfold, is pulled back towards its "
+        "stress-free start); incremental: the last stress plus the current moduli times the "
+        "strain increment (the stress stays continuous through melting and freezing)",
     )
     optimize: bool = Field(
         False,

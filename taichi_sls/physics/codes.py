@@ -52,3 +52,10 @@ class SurfaceMethod(IntEnum):
 
     CSF = 0  # the paper's level set, curvature and CSF force (eqs. 19-24)
     SURFACE_ENERGY = 1  # the gradient of gamma times the outline's length
+
+
+class StressForm(IntEnum):
+    """``solver.stress_form``."""
+
+    TOTAL = 0  # stress from the accumulated elastic strain at the current moduli (eqs. 38-39)
+    INCREMENTAL = 1  # the last stress plus the current moduli times the strain increment

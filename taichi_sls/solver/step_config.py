@@ -9,7 +9,14 @@ import math
 from dataclasses import dataclass
 
 from ..config import Case
-from ..physics.codes import StressReading, SurfaceMethod, Transfer, Update, WallMechanical
+from ..physics.codes import (
+    StressForm,
+    StressReading,
+    SurfaceMethod,
+    Transfer,
+    Update,
+    WallMechanical,
+)
 from ..physics.materials import KELVIN
 from .scene import Scene
 
@@ -53,6 +60,7 @@ class StepConfig:
     gravity: tuple[float, float]
     has_gravity: bool
     stress_reading: StressReading
+    stress_form: StressForm
     # ---- transfers and layout
     transfer: Transfer
     flip_ratio: float
@@ -139,6 +147,7 @@ def step_config(
         gravity=tuple(ph.gravity_m_s2),
         has_gravity=any(g != 0.0 for g in ph.gravity_m_s2),
         stress_reading=StressReading.PAPER if sv.stress_reading == "paper" else StressReading.MODEL,
+        stress_form=StressForm[sv.stress_form.upper()],
         transfer=Transfer[sv.transfer.upper()],
         flip_ratio=sv.flip_ratio,
         update=Update[sv.update.upper()],

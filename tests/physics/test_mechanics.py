@@ -210,3 +210,35 @@ def test_elastic_limit_uses_the_stiffer_phase_with_its_own_nu():
     M_melt = p_wave_modulus(1e4, 0.499)
     assert M_melt > M_solid
     assert lim == pytest.approx(h / np.sqrt(M_melt / 1020.0), rel=1e-12)
+
+
+def test_incremental_stress_is_continuous_when_the_moduli_change():
+    """solver.stress_form: with fixed moduli the incremental update gives the total form's
+    stress (to round-off, here along a strain path of 20 steps); when the solid fraction jumps
+    from 0 (melt, E = 1e4 Pa) to 1 (solid, E = 1e5 Pa) at a fixed strain, the total form's
+    stress jumps tenfold (the frozen melt springs back), the incremental one's stays."""
+    from taichi_sls.physics.constitutive import perzyna_increment
+
+    init_taichi(optimize=False)
+    m = Material(youngs_solid_Pa=1e5, youngs_liquid_Pa=1e4, poisson=0.42, poisson_liquid=0.42)
+    mat = material_field(m)
+    out = ti.Matrix.field(3, 3, float, 4)
+
+    @ti.kernel
+    def run():
+        z = ti.Matrix.zero(float, 3, 3)
+        d = embed3(ti.Matrix([[1e-4, 3e-5], [3e-5, -2e-5]]))
+        sig = z
+        for _ in range(20):
+            sig = perzyna_increment(mat[0], sig, d, 0.0, z, 0.0, 0.0, 500.0, 1e-3, False)[0]
+        total = perzyna_update(mat[0], 20.0 * d, z, 0.0, 0.0, 0.0, 500.0, 1e-3, False, MODEL)[0]
+        out[0] = sig
+        out[1] = total
+        out[2] = perzyna_increment(mat[0], sig, z, 0.0, z, 0.0, 1.0, 500.0, 1e-3, False)[0]
+        out[3] = perzyna_update(mat[0], 20.0 * d, z, 0.0, 0.0, 1.0, 500.0, 1e-3, False, MODEL)[0]
+
+    run()
+    r = out.to_numpy()
+    np.testing.assert_allclose(r[0], r[1], rtol=1e-12, atol=1e-12 * np.abs(r[1]).max())
+    np.testing.assert_allclose(r[2], r[0], rtol=1e-14)  # frozen at a fixed strain: the same
+    np.testing.assert_allclose(r[3], 10.0 * r[1], rtol=1e-12)  # the total form: ten times
