@@ -144,12 +144,15 @@ class Solver(Model):
         0.9, ge=0, le=1, description="FLIP share of the pic_flip blend, in [0, 1]"
     )
     arch: Literal["cpu", "gpu"] = Field("cpu", description="Taichi backend")
-    layout: Literal["auto", "serial", "parallel"] = Field(
+    layout: Literal["auto", "serial", "parallel", "blocks"] = Field(
         "auto",
-        description="serial: many steps per kernel call, loops serialized; parallel: one call "
-        "per step, every stage a parallel loop; auto: serial on CPU (faster at every size "
-        "measured on 2 cores, to 1M points), parallel on GPU",
+        description="serial: many steps per kernel call, loops serialized (one core); "
+        "parallel: one call per step, every loop parallel with atomic scatters (GPU); blocks: "
+        "one call per step, the points sorted into blocks scattered in four colour passes "
+        "without atomics (every CPU core, the same result at any thread count); auto: parallel "
+        "on a GPU, blocks on a CPU from 20k points with more than one thread, else serial",
     )
+    threads: int = Field(0, ge=0, description="CPU threads Taichi may use (0: every core)")
     active_region: bool = Field(
         True,
         description="grid loops only over the nodes that material has reached (plus the "

@@ -24,3 +24,23 @@ def ramped_gamma(cfg: ti.template(), t):
     if ti.static(cfg.gamma_ramp_s > 0.0):
         gamma *= ti.min(1.0, t / cfg.gamma_ramp_s)
     return gamma
+
+
+@ti.func
+def scatter_add(cfg: ti.template(), field: ti.template(), I, v):
+    """field[I] += v. An atomic add where writers of several threads may meet at a node (the
+    parallel layout); a plain one where the layout keeps them apart (``race_free``: the blocks
+    layout, whose threads scatter from blocks of cells far enough apart)."""
+    if ti.static(cfg.race_free):
+        field[I] = field[I] + v
+    else:
+        field[I] += v
+
+
+@ti.func
+def scatter_min(cfg: ti.template(), field: ti.template(), I, v):
+    """field[I] = min(field[I], v), atomic or plain as :func:`scatter_add`."""
+    if ti.static(cfg.race_free):
+        field[I] = ti.min(field[I], v)
+    else:
+        ti.atomic_min(field[I], v)

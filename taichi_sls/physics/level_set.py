@@ -17,7 +17,7 @@ the contour segments (``seg.ends`` up to two per cell, ``seg.count``).
 import taichi as ti
 
 from .contour import cell_segments
-from .grid import active
+from .grid import active, scatter_min
 
 
 @ti.func
@@ -27,7 +27,7 @@ def scatter_level_set(cfg: ti.template(), pt: ti.template(), nd: ti.template(), 
     for a, b in ti.static(ti.ndrange(5, 5)):
         I = base + ti.Vector([a - 1, b - 1])
         xi = ti.cast(I - cfg.off, float) * cfg.h
-        ti.atomic_min(nd.phi_raw[I], (xi - xp).norm() - cfg.r_p)
+        scatter_min(cfg, nd.phi_raw, I, (xi - xp).norm() - cfg.r_p)
 
 
 @ti.func

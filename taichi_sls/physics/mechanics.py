@@ -29,7 +29,7 @@ stays the default.
 import taichi as ti
 
 from .codes import Transfer, WallMechanical
-from .grid import node_x
+from .grid import node_x, scatter_add
 from .shape import STENCIL, node_weight
 
 
@@ -62,12 +62,12 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         mv = vp
         if ti.static(cfg.transfer == Transfer.APIC):
             mv += pt.C[p] @ (node_x(cfg, I) - xp)
-        nd.mass[I] += N * mi
-        nd.momentum[I] += N * mi * mv
+        scatter_add(cfg, nd.mass, I, N * mi)
+        scatter_add(cfg, nd.momentum, I, N * mi * mv)
         f = -Vp * (sig @ gN)
         if ti.static(cfg.has_gravity):
             f += N * mp * g
-        nd.force[I] += f
+        scatter_add(cfg, nd.force, I, f)
 
 
 @ti.func
@@ -169,7 +169,7 @@ def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
         mv = pt.v[p]
         if ti.static(cfg.transfer == Transfer.APIC):
             mv += pt.C[p] @ (node_x(cfg, I) - xp)
-        nd.momentum[I] += N * mp * mv
+        scatter_add(cfg, nd.momentum, I, N * mp * mv)
 
 
 @ti.func

@@ -37,7 +37,7 @@ import math
 import taichi as ti
 
 from .contour import cell_segments
-from .grid import active, ramped_gamma
+from .grid import active, ramped_gamma, scatter_add
 from .shape import STENCIL, node_weight, stencil
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
@@ -59,7 +59,7 @@ def scatter_volume(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
     Vp = pt.volume0[p] * pt.J[p]
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
-        nd.volume[base + o] += N * Vp
+        scatter_add(cfg, nd.volume, base + o, N * Vp)
 
 
 @ti.func
@@ -106,13 +106,13 @@ def segment_force(cfg: ti.template(), nd: ti.template(), a, b, gamma):
                 tg = t.dot(gN)
                 if tg != 0.0:
                     if ti.static(cfg.se.spread):
-                        nd.surface_force[I] += (-gamma * wq[q] * L * tg) * t
+                        scatter_add(cfg, nd.surface_force, I, (-gamma * wq[q] * L * tg) * t)
                     elif ti.static(cfg.se.floor_mass > 0.0):
                         m = nd.mass[I]
                         scale = m / ti.max(m, cfg.se.floor_mass)
-                        nd.force[I] += (-gamma * wq[q] * L * tg * scale) * t
+                        scatter_add(cfg, nd.force, I, (-gamma * wq[q] * L * tg * scale) * t)
                     else:
-                        nd.force[I] += (-gamma * wq[q] * L * tg) * t
+                        scatter_add(cfg, nd.force, I, (-gamma * wq[q] * L * tg) * t)
 
 
 @ti.func
@@ -124,7 +124,7 @@ def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()
         f = nd.surface_force[I]
         m = nd.mass[I]
         if m >= cfg.se.floor_mass:
-            nd.force[I] += f
+            scatter_add(cfg, nd.force, I, f)
         elif f.norm_sqr() > 0.0:
             M = 0.0
             for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
@@ -133,12 +133,12 @@ def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()
             keep = m / cfg.se.floor_mass
             if M <= 0.0:
                 keep = 1.0
-            nd.force[I] += keep * f
+            scatter_add(cfg, nd.force, I, keep * f)
             if M > 0.0:
                 rest = (1.0 - keep) / M * f
                 for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
                     if ti.static(o[0] != 0 or o[1] != 0):
-                        nd.force[I + o] += nd.mass[I + o] * rest
+                        scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
 
 
 @ti.func

@@ -26,11 +26,14 @@ to them are updated as ``g2p_heat`` says, so that none is pushed past the wall t
 (MODEL.md: resetting the nodes by increments drove points beside the plate to 110 C).
 
 Arguments: ``cfg`` the step's configuration, ``pt`` points, ``nd`` nodes, ``mat`` materials,
-``sc`` the run's scalars (laser energy, heat out, peak temperature), ``lasers`` the beams.
+``sc`` the run's scalars (heat out through the walls' nodes), ``lasers`` the beams. The point
+functions return what a point adds to the run's totals (laser energy, heat out); the solver
+accumulates them as its layout needs.
 """
 
 import taichi as ti
 
+from .grid import scatter_add
 from .laser import laser_source
 from .materials import (
     apparent_heat_capacity,
@@ -43,14 +46,16 @@ from .shape import STENCIL, node_weight
 
 
 @ti.func
-def p2g_heat_capacity(pt: ti.template(), nd: ti.template(), mat: ti.template(), p, base, w, dw):
+def p2g_heat_capacity(
+    cfg: ti.template(), pt: ti.template(), nd: ti.template(), mat: ti.template(), p, base, w, dw
+):
     mp = pt.mass[p]
     c = apparent_heat_capacity(mat[pt.material[p]], pt.T[p])
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         I = base + o
-        nd.heat_capacity[I] += N * mp * c
-        nd.capacity_T[I] += N * mp * c * pt.T[p]
+        scatter_add(cfg, nd.heat_capacity, I, N * mp * c)
+        scatter_add(cfg, nd.capacity_T, I, N * mp * c * pt.T[p])
 
 
 @ti.func
@@ -88,7 +93,6 @@ def p2g_heat_flux(
     pt: ti.template(),
     nd: ti.template(),
     mat: ti.template(),
-    sc: ti.template(),
     lasers: ti.template(),
     p,
     base,
@@ -98,7 +102,8 @@ def p2g_heat_flux(
     dt,
 ):
     """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate;
-    with the sub-grid filter on, the point's deviation from the grid temperature too."""
+    with the sub-grid filter on, the point's deviation from the grid temperature too. Returns
+    the laser energy the point took (J/m)."""
     gT = ti.Vector.zero(float, cfg.dim)
     T_grid = 0.0
     w_fixed = 0.0
@@ -118,17 +123,19 @@ def p2g_heat_flux(
             d = pt.T[p] - T_grid
             for o in ti.static(ti.grouped(STENCIL)):
                 N, gN = node_weight(w, dw, o)
-                nd.deviation[base + o] += N * mc * d
-                nd.deviation_capacity[base + o] += N * mc
+                scatter_add(cfg, nd.deviation, base + o, N * mc * d)
+                scatter_add(cfg, nd.deviation_capacity, base + o, N * mc)
     k = lerp_phase(pt.solid_fraction[p], mp.conductivity_solid_W_mK, mp.conductivity_liquid_W_mK)
     Vp = pt.volume0[p] * pt.J[p]
     s = 0.0
+    energy = 0.0  # the laser energy the point takes this heat step
     if ti.static(cfg.laser):
         s = laser_source(lasers, cfg.n_lasers, pt.x[p], t, dt)
-        sc.laser_energy[None] += Vp * s * dt
+        energy = Vp * s * dt
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
-        nd.heat_rate[base + o] += -Vp * k * gT.dot(gN) + Vp * s * N
+        scatter_add(cfg, nd.heat_rate, base + o, -Vp * k * gT.dot(gN) + Vp * s * N)
+    return energy
 
 
 @ti.func
@@ -149,13 +156,13 @@ def g2p_heat(
     pt: ti.template(),
     nd: ti.template(),
     mat: ti.template(),
-    sc: ti.template(),
     p,
     base,
     w,
     dw,
 ):
-    """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains.
+    """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains and the
+    heat the point exchanged with fixed walls (J/m, counted in heat_out).
 
     Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
     transfer). A point within the support of a fixed node takes the interpolated grid temperature
@@ -187,6 +194,7 @@ def g2p_heat(
     xi0 = pt.solid_fraction[p]
     c0 = apparent_heat_capacity(mp, T0)
     dH = c0 * dTg
+    heat_out = 0.0
     if ti.static(cfg.subgrid_filter > 0.0):
         if w_fixed == 0.0:
             # the sub-grid part of the deviation relaxes (module docstring): exactly
@@ -195,12 +203,11 @@ def g2p_heat(
     if ti.static(cfg.any_fixed):
         if w_fixed > 0.0:
             H_pic = enthalpy(mp, T_pic)
-            sc.heat_out[None] -= pt.mass[p] * (H_pic - pt.enthalpy[p] - dH)
+            heat_out = -(pt.mass[p] * (H_pic - pt.enthalpy[p] - dH))
             dH = H_pic - pt.enthalpy[p]
     pt.enthalpy[p] += dH
     T1 = temperature_from_enthalpy(mp, pt.enthalpy[p])
     xi1 = solid_fraction(mp, T1)
     pt.T[p] = T1
     pt.solid_fraction[p] = xi1
-    ti.atomic_max(sc.T_peak[None], T1)
-    return T1 - T0, xi1 - xi0
+    return T1 - T0, xi1 - xi0, heat_out

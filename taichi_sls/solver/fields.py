@@ -136,8 +136,10 @@ class State:
         scene: Scene,
         materials: dict[str, np.ndarray],
         lasers: dict[str, np.ndarray],
+        blocks=None,
     ) -> None:
         self.cfg = cfg
+        self.blocks = blocks  # the blocks layout's plan (solver/blocks.py), else None
         self.scene = scene
         self.points = struct_type(POINT_MEMBERS, cfg.dim).field(
             shape=scene.n_points, layout=ti.Layout.SOA

@@ -13,18 +13,23 @@ import taichi as ti
 from ..config import Case
 from ..physics.materials import KELVIN
 from . import checkpoint
+from .blocks import BlockPlan
 from .fields import State
 from .guard import Guard
 from .monitor import body_centroids_x, neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
 from .step import advance, colour_only, init_box, level_set_only
-from .step_config import step_config
+from .step_config import Layout, choose_layout, step_config
 from .time_step import resolve_curvature_every, resolve_dt, resolve_heat_every
 
 
 def init_taichi(
-    arch: str = "cpu", precision: str = "f64", optimize: bool = False, fast_math: bool = True
+    arch: str = "cpu",
+    precision: str = "f64",
+    optimize: bool = False,
+    fast_math: bool = True,
+    threads: int = 0,
 ) -> None:
     """(Re)initialise Taichi. Re-initialising frees every field, so one Simulation is live at a
     time. ``optimize=False`` skips Taichi's advanced IR optimisation: the fused step compiles in
@@ -38,6 +43,7 @@ def init_taichi(
         advanced_optimization=optimize,
         fast_math=fast_math,
         log_level=ti.ERROR,
+        **({"cpu_max_num_threads": threads} if threads else {}),
     )
 
 
@@ -60,13 +66,19 @@ class Simulation:
     ) -> None:
         if init:
             sv = case.solver
-            init_taichi(sv.arch, sv.precision, sv.optimize, sv.fast_math)
+            init_taichi(sv.arch, sv.precision, sv.optimize, sv.fast_math, sv.threads)
         self.case = case
         self.before_step = before_step
         self.dt, self.dt_limits = resolve_dt(case)
         self.heat_every = resolve_heat_every(case, self.dt, self.dt_limits)
         self.curvature_every = resolve_curvature_every(case, self.dt, self.dt_limits)
         self.scene: Scene = build_scene(case) if scene is None else scene
+        self.blocks: BlockPlan | None = None
+        if choose_layout(case, self.scene.n_points) == Layout.BLOCKS:
+            h, off = self.scene.h, self.scene.off
+            self.blocks = BlockPlan(self.scene.nx, self.scene.ny, h, off)
+            self.scene = self.scene.reordered(self.blocks.order(self.scene.x))
+            self.blocks.set_ranges(self.scene.x)
         cfg = step_config(
             case,
             self.scene,
@@ -76,7 +88,7 @@ class Simulation:
             self.dt_limits.get("thermal", math.inf),
         )
         mats = material_arrays(case, self.scene.material_names)
-        self.state = State(cfg, self.scene, mats, laser_arrays(case))
+        self.state = State(cfg, self.scene, mats, laser_arrays(case), self.blocks)
         self.state.scalars.dt[None] = self.dt
         init_box(self.state)
         self.steps = 0
@@ -110,9 +122,26 @@ class Simulation:
             for _ in range(n):
                 self.before_step(self)
                 advance(self.state, 1)
+        elif self.blocks is not None:
+            for _ in range(n):  # a point that drifted out of its block: sort them again
+                advance(self.state, 1)
+                if self.blocks.needs_sort[None]:
+                    self.sort_points()
         else:
             advance(self.state, n)
         self.steps += n
+
+    def sort_points(self) -> None:
+        """Blocks layout: the points sorted by block again (every per-point array and the
+        scene's), and the blocks' ranges."""
+        pt = self.state.points
+        x = pt.x.to_numpy()
+        order = self.blocks.order(x)
+        pt.from_numpy({k: v[order] for k, v in pt.to_numpy().items()})
+        self.scene = self.scene.reordered(order)
+        self.state.scene = self.scene
+        self._mass = self._mass[order]
+        self.blocks.set_ranges(x[order])
 
     # ------------------------------------------------------------------ monitors
     def phi(self) -> np.ndarray:

@@ -50,6 +50,15 @@ from ..physics.thermal import (
     p2g_heat_flux,
 )
 from .fields import State
+from .loops import (
+    add_heat_out,
+    add_laser_energy,
+    check_block,
+    grow_box,
+    peak_temperature,
+    point_loop,
+    reduce_blocks,
+)
 
 
 @ti.func
@@ -63,24 +72,14 @@ def point_stencil(cfg: ti.template(), pt: ti.template(), p):
 
 
 @ti.func
-def grow_box(st: ti.template(), p):
-    """Grow the active region to hold point p's level-set footprint (5x5 nodes) plus
-    ``box_margin`` nodes; grid loops run over it only. It never shrinks, so no node outside it
-    has ever been written: there every field keeps its empty initial value. Called where a
-    point has moved (the end of G2P), so that the next step's grid loops cover it."""
-    if ti.static(st.cfg.active_region):
-        m = ti.static(st.cfg.box_margin)
-        base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
-        ti.atomic_min(st.box[None][0], ti.max(base[0] - 1 - m, 0))
-        ti.atomic_min(st.box[None][1], ti.max(base[1] - 1 - m, 0))
-        ti.atomic_max(st.box[None][2], ti.min(base[0] + 4 + m, st.cfg.nx))
-        ti.atomic_max(st.box[None][3], ti.min(base[1] + 4 + m, st.cfg.ny))
+def _grow_box_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    grow_box(st, blk, p)
 
 
 @ti.func
 def grow_box_all(st: ti.template()):
-    for p in range(st.cfg.n_points):
-        grow_box(st, p)
+    point_loop(st, _grow_box_body, False, False, False)
+    reduce_blocks(st)
 
 
 @ti.kernel
@@ -120,20 +119,24 @@ def _energy(st) -> bool:
 
 
 @ti.func
-def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
+def _p2g_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     pt, nd = ti.static(st.points, st.nodes)
-    for p in range(st.cfg.n_points):
-        base, w, dw = point_stencil(st.cfg, pt, p)
-        if ti.static(st.cfg.mech):
-            p2g_mechanics(st.cfg, pt, nd, p, base, w, dw)
-        if ti.static(st.cfg.thermal):
-            if heat:
-                p2g_heat_capacity(pt, nd, st.materials, p, base, w, dw)
-        if ti.static(_csf(st)):
-            if geom:
-                scatter_level_set(st.cfg, pt, nd, p, base)
-        if ti.static(_energy(st) and st.cfg.se.volume_colour):
-            scatter_volume(st.cfg, pt, nd, p, base, w, dw)
+    base, w, dw = point_stencil(st.cfg, pt, p)
+    if ti.static(st.cfg.mech):
+        p2g_mechanics(st.cfg, pt, nd, p, base, w, dw)
+    if ti.static(st.cfg.thermal):
+        if heat:
+            p2g_heat_capacity(st.cfg, pt, nd, st.materials, p, base, w, dw)
+    if ti.static(_csf(st)):
+        if geom:
+            scatter_level_set(st.cfg, pt, nd, p, base)
+    if ti.static(_energy(st) and st.cfg.se.volume_colour):
+        scatter_volume(st.cfg, pt, nd, p, base, w, dw)
+
+
+@ti.func
+def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    point_loop(st, _p2g_body, heat, geom, True)
 
 
 @ti.func
@@ -173,15 +176,19 @@ def surface_force(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 
 @ti.func
-def _heat_flux_loop(st: ti.template()):
+def _heat_flux_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     dt_heat = st.scalars.dt[None] * st.cfg.heat_every
     t = st.scalars.t[None]
     pt = ti.static(st.points)
-    for p in range(st.cfg.n_points):
-        base, w, dw = point_stencil(st.cfg, pt, p)
-        p2g_heat_flux(
-            st.cfg, pt, st.nodes, st.materials, st.scalars, st.lasers, p, base, w, dw, t, dt_heat
-        )
+    base, w, dw = point_stencil(st.cfg, pt, p)
+    e = p2g_heat_flux(st.cfg, pt, st.nodes, st.materials, st.lasers, p, base, w, dw, t, dt_heat)
+    if ti.static(st.cfg.laser):
+        add_laser_energy(st, blk, e)
+
+
+@ti.func
+def _heat_flux_loop(st: ti.template()):
+    point_loop(st, _heat_flux_body, True, False, True)
 
 
 @ti.func
@@ -209,14 +216,17 @@ def grid_update(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 @ti.func
 def g2p_point(
-    st: ti.template(), p, base, w, dw, dt, kinematics: ti.template(), heat: ti.template()
+    st: ti.template(), p, blk, base, w, dw, dt, kinematics: ti.template(), heat: ti.template()
 ):
     """Heat, thermal strains and velocity of point p; with ``kinematics`` (USL) also its motion
     and stress."""
     pt, nd, mat = ti.static(st.points, st.nodes, st.materials)
     if ti.static(st.cfg.thermal):
         if heat:
-            dT, dxi = g2p_heat(st.cfg, pt, nd, mat, st.scalars, p, base, w, dw)
+            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw)
+            if ti.static(st.cfg.any_fixed):
+                add_heat_out(st, blk, q)
+            peak_temperature(st, blk, pt.T[p])
             if pt.solid_fraction[p] == 0.0:  # above T_m for this heat step
                 pt.time_molten[p] += dt * st.cfg.heat_every
             if ti.static(st.cfg.th_strain and st.cfg.mech):
@@ -245,34 +255,52 @@ def watch(st: ti.template(), p):
         ti.atomic_min(sc.first_nan[None], k)
 
 
+def _musl(st) -> bool:
+    return st.cfg.update == Update.MUSL
+
+
+@ti.func
+def _g2p_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    g2p_point(st, p, blk, base, w, dw, st.scalars.dt[None], ti.static(not _musl(st)), heat)
+    watch(st, p)
+    if ti.static(not _musl(st)):
+        grow_box(st, blk, p)
+        check_block(st, blk, p)
+
+
+@ti.func
+def _momentum_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    p2g_momentum(st.cfg, st.points, st.nodes, p, base, w, dw)
+
+
+@ti.func
+def _kinematics_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    dt = st.scalars.dt[None]
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    L = g2p_kinematics(st.cfg, st.points, st.nodes, p, base, w, dw, dt)
+    stress_update(st.cfg, st.points, st.materials, p, L, dt)
+    grow_box(st, blk, p)
+    check_block(st, blk, p)
+
+
 @ti.func
 def g2p(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    pt, nd = ti.static(st.points, st.nodes)
-    dt = st.scalars.dt[None]
-    musl = ti.static(st.cfg.update == Update.MUSL)
-    for p in range(st.cfg.n_points):
-        base, w, dw = point_stencil(st.cfg, pt, p)
-        g2p_point(st, p, base, w, dw, dt, not musl, heat)
-        watch(st, p)
-        if ti.static(not musl):
-            grow_box(st, p)
-    if ti.static(musl and st.cfg.mech):
+    nd = ti.static(st.nodes)
+    point_loop(st, _g2p_body, heat, geom, False)
+    if ti.static(_musl(st) and st.cfg.mech):
         for I in ti.grouped(ti.ndrange(*active(st.box))):
             nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
-        for p in range(st.cfg.n_points):
-            base, w, dw = point_stencil(st.cfg, pt, p)
-            p2g_momentum(st.cfg, pt, nd, p, base, w, dw)
+        point_loop(st, _momentum_body, heat, geom, True)
         for I in ti.grouped(ti.ndrange(*active(st.box))):
             grid_remap_velocity(st.cfg, nd, I)
-        for p in range(st.cfg.n_points):
-            base, w, dw = point_stencil(st.cfg, pt, p)
-            L = g2p_kinematics(st.cfg, pt, nd, p, base, w, dw, dt)
-            stress_update(st.cfg, pt, st.materials, p, L, dt)
-            grow_box(st, p)
+        point_loop(st, _kinematics_body, heat, geom, False)
 
 
 @ti.func
 def advance_clock(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    reduce_blocks(st)
     st.scalars.t[None] = st.scalars.t[None] + st.scalars.dt[None]
     st.scalars.step[None] += 1
 
@@ -350,10 +378,14 @@ def level_set_only(st: ti.template()):
     grow_box_all(st)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         st.nodes.phi_raw[I] = st.cfg.phi_cap
-    for p in range(st.cfg.n_points):
-        base, w, dw = point_stencil(st.cfg, st.points, p)
-        scatter_level_set(st.cfg, st.points, st.nodes, p, base)
+    point_loop(st, _level_set_body, False, True, True)
     level_set(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.func
+def _level_set_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    scatter_level_set(st.cfg, st.points, st.nodes, p, base)
 
 
 @ti.kernel

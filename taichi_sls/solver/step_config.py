@@ -6,7 +6,9 @@ fields instead."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
+from enum import IntEnum
 
 from ..config import Case
 from ..physics.codes import (
@@ -20,6 +22,17 @@ from ..physics.codes import (
 from ..physics.materials import KELVIN
 from .scene import Scene
 
+
+class Layout(IntEnum):
+    """How a step runs (``solver.layout``, solver/step.py)."""
+
+    SERIAL = 0  # many steps per kernel call, every loop serial (one CPU core)
+    PARALLEL = 1  # one call per step, every loop parallel with atomic scatters (GPU)
+    BLOCKS = 2  # one call per step, points by blocks in four colours (every CPU core)
+
+
+# the blocks layout pays for itself above about this many points (docs/speed.md)
+BLOCKS_FROM_POINTS = 20_000
 T_RUNAWAY_K = 1e4  # no polymer state of this model lives above it (the guard's bound too)
 
 
@@ -65,7 +78,9 @@ class StepConfig:
     transfer: Transfer
     flip_ratio: float
     update: Update
-    parallel: bool  # one parallel kernel call per step (GPU) or serialized steps (CPU)
+    layout: Layout
+    parallel: bool  # one kernel call per step, its loops parallel (not the serial layout)
+    race_free: bool  # the layout keeps scattering threads apart: plain adds (blocks)
     active_region: bool
     box_margin: int  # nodes beyond the points' footprint that the step still changes
     # ---- clocks
@@ -98,12 +113,22 @@ class StepConfig:
     T_runaway: float
 
 
-def parallel_layout(case: Case) -> bool:
-    """One parallel kernel call per step (True) or many serialized steps per call (False)."""
+def threads(case: Case) -> int:
+    """The CPU threads the run may use (``solver.threads``, 0: every core)."""
+    return case.solver.threads or os.cpu_count() or 1
+
+
+def choose_layout(case: Case, n_points: int) -> Layout:
+    """``solver.layout``; "auto": parallel on a GPU; on a CPU the blocks layout for large
+    scenes when there is more than one thread, else the serial one."""
     lay = case.solver.layout
-    if lay == "auto":
-        return case.solver.arch == "gpu"
-    return lay == "parallel"
+    if lay != "auto":
+        return Layout[lay.upper()]
+    if case.solver.arch == "gpu":
+        return Layout.PARALLEL
+    if n_points >= BLOCKS_FROM_POINTS and threads(case) > 1:
+        return Layout.BLOCKS
+    return Layout.SERIAL
 
 
 def step_config(
@@ -124,6 +149,7 @@ def step_config(
     csf = surface and method == SurfaceMethod.CSF
     thermal = ph.thermal
     rho_ref = first.density_kg_m3 * sv.mass_scale
+    layout = choose_layout(case, scene.n_points)
     floor = st.surface_energy_mass_floor * rho_ref * h**2
     return StepConfig(
         dim=2,
@@ -151,7 +177,9 @@ def step_config(
         transfer=Transfer[sv.transfer.upper()],
         flip_ratio=sv.flip_ratio,
         update=Update[sv.update.upper()],
-        parallel=parallel_layout(case),
+        layout=layout,
+        parallel=layout != Layout.SERIAL,
+        race_free=layout == Layout.BLOCKS,
         active_region=sv.active_region,
         # CSF: the level-set band and the blur's reach, plus one for the 3x3 fits; surface
         # energy: the Gauss points of the cells next to the points' nodes

@@ -1,0 +1,127 @@
+"""How a stage visits the points, and where what they add to the run's totals goes: one loop
+over all points (the serial and parallel layouts), or the blocks layout's loops over blocks of
+sorted points (solver/blocks.py), scatters in four colour passes, with per-block accumulators.
+
+A stage hands a point body ``body(st, p, blk, heat, geom)`` to :func:`point_loop`; ``blk`` is
+the point's block (0 outside the blocks layout)."""
+
+import taichi as ti
+
+from .blocks import MARGIN, SIDE
+from .step_config import Layout
+
+
+def blocks(st) -> bool:
+    return st.cfg.layout == Layout.BLOCKS
+
+
+@ti.func
+def point_loop(
+    st: ti.template(),
+    body: ti.template(),
+    heat: ti.template(),
+    geom: ti.template(),
+    scatter: ti.template(),
+):
+    """``body`` for every point. ``scatter``: the body writes to the nodes around its point, so
+    in the blocks layout it runs colour by colour."""
+    if ti.static(blocks(st)):
+        if ti.static(scatter):
+            for c in ti.static(range(4)):
+                for k in range(ti.static(st.blocks.n_colour[c])):
+                    b = st.blocks.by_colour[c, k]
+                    for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
+                        body(st, p, b, heat, geom)
+        else:
+            for b in range(st.blocks.n_blocks):
+                for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
+                    body(st, p, b, heat, geom)
+    else:
+        for p in range(st.cfg.n_points):
+            body(st, p, 0, heat, geom)
+
+
+@ti.func
+def add_laser_energy(st: ti.template(), blk, e):
+    if ti.static(blocks(st)):
+        st.blocks.laser_energy[blk] = st.blocks.laser_energy[blk] + e
+    else:
+        st.scalars.laser_energy[None] += e
+
+
+@ti.func
+def add_heat_out(st: ti.template(), blk, q):
+    if ti.static(blocks(st)):
+        st.blocks.heat_out[blk] = st.blocks.heat_out[blk] + q
+    else:
+        st.scalars.heat_out[None] += q
+
+
+@ti.func
+def peak_temperature(st: ti.template(), blk, T):
+    if ti.static(blocks(st)):
+        st.blocks.T_peak[blk] = ti.max(st.blocks.T_peak[blk], T)
+    else:
+        ti.atomic_max(st.scalars.T_peak[None], T)
+
+
+@ti.func
+def grow_box(st: ti.template(), blk, p):
+    """Grow the active region to hold point p's level-set footprint (5x5 nodes) plus
+    ``box_margin`` nodes; grid loops run over it only. It never shrinks, so no node outside it
+    has ever been written: there every field keeps its empty initial value. Called where a
+    point has moved (the end of G2P), so that the next step's grid loops cover it."""
+    if ti.static(st.cfg.active_region):
+        m = ti.static(st.cfg.box_margin)
+        base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
+        lo = ti.Vector([ti.max(base[0] - 1 - m, 0), ti.max(base[1] - 1 - m, 0)])
+        hi = ti.Vector([ti.min(base[0] + 4 + m, st.cfg.nx), ti.min(base[1] + 4 + m, st.cfg.ny)])
+        if ti.static(blocks(st)):
+            st.blocks.box[blk] = widen(st.blocks.box[blk], lo, hi)
+        else:
+            ti.atomic_min(st.box[None][0], lo[0])
+            ti.atomic_min(st.box[None][1], lo[1])
+            ti.atomic_max(st.box[None][2], hi[0])
+            ti.atomic_max(st.box[None][3], hi[1])
+
+
+@ti.func
+def check_block(st: ti.template(), blk, p):
+    """Blocks layout: flag a point that has drifted MARGIN cells out of its block (the points
+    are then sorted again before the next step)."""
+    if ti.static(blocks(st)):
+        cell = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h), ti.i32) + st.cfg.off
+        b0 = ti.Vector([blk % st.blocks.n_bx, blk // st.blocks.n_bx]) * SIDE
+        if (cell < b0 - MARGIN).any() or (cell >= b0 + SIDE + MARGIN).any():
+            st.blocks.needs_sort[None] = 1
+
+
+@ti.func
+def reduce_blocks(st: ti.template()):
+    """Blocks layout: the per-block accumulators into the run's totals, in block order (the
+    result does not depend on the thread count), and reset."""
+    if ti.static(blocks(st)):
+        sc = ti.static(st.scalars)
+        ti.loop_config(serialize=True)
+        for b in range(st.blocks.n_blocks):
+            sc.laser_energy[None] += st.blocks.laser_energy[b]
+            sc.heat_out[None] += st.blocks.heat_out[b]
+            sc.T_peak[None] = ti.max(sc.T_peak[None], st.blocks.T_peak[b])
+            bx = st.blocks.box[b]
+            st.box[None] = widen(st.box[None], ti.Vector([bx[0], bx[1]]), ti.Vector([bx[2], bx[3]]))
+            st.blocks.laser_energy[b] = 0.0
+            st.blocks.heat_out[b] = 0.0
+            st.blocks.box[b] = box_empty(st)
+
+
+@ti.func
+def box_empty(st: ti.template()):
+    return ti.Vector([st.cfg.nx, st.cfg.ny, 0, 0])
+
+
+@ti.func
+def widen(box, lo, hi):
+    """The box [i0, j0, i1, j1) grown to hold [lo, hi)."""
+    return ti.Vector(
+        [ti.min(box[0], lo[0]), ti.min(box[1], lo[1]), ti.max(box[2], hi[0]), ti.max(box[3], hi[1])]
+    )
