@@ -66,38 +66,42 @@ def perzyna_update(
         s = 2.0 * mu * ee - tr / 3.0 * I3
         p = (K - 2.0 * mu / 3.0) * eps3.trace()
     if ti.static(plastic):
-        s, eps_pl, alpha = perzyna_return(mp, s, eps_pl, alpha, mu, xi, T, dt)
+        s, dgam, n = perzyna_return(mp, s, alpha, mu, xi, T, dt)
+        if dgam > 0.0:
+            eps_pl += dgam * n
+            alpha += SQRT23 * dgam
     return p * I3 + s, eps_pl, alpha
 
 
 @ti.func
-def perzyna_return(mp: ti.template(), s, eps_pl, alpha, mu, xi, T, dt):
-    """The viscoplastic correction of a trial deviator s (eqs. 40-45). Returns (s, eps_pl,
-    alpha)."""
+def perzyna_return(mp: ti.template(), s, alpha, mu, xi, T, dt):
+    """The viscoplastic correction of a trial deviator s (eqs. 40-45). Returns (s, dgamma, n):
+    the corrected deviator and the plastic multiplier and direction (dgamma = 0: elastic)."""
     sy = lerp_phase(xi, mp.yield_solid_Pa, mp.yield_liquid_Pa)
     Hh = lerp_phase(xi, mp.hardening_solid_Pa, mp.hardening_liquid_Pa)
     snorm = s.norm()
     f = snorm - SQRT23 * (sy + Hh * alpha)
+    dgam = 0.0
+    n = ti.Matrix.zero(float, 3, 3)
     if f > 0.0:
         tau = viscosity(mp, T) / (2.0 * mu)
         dgam = (f / (2.0 * mu)) / (tau / dt + 1.0 + Hh / (3.0 * mu))
         n = s / snorm
-        eps_pl += dgam * n
-        alpha += SQRT23 * dgam
         s -= 2.0 * mu * dgam * n
-    return s, eps_pl, alpha
+    return s, dgam, n
 
 
 @ti.func
 def perzyna_increment(
-    mp: ti.template(), sigma, deps3, d_iso, eps_pl, alpha, xi, T, dt, plastic: ti.template()
+    mp: ti.template(), sigma, deps3, d_iso, alpha, xi, T, dt, plastic: ti.template()
 ):
     """The incremental (hypoelastic) form of the same step: the trial stress is the last stress
     plus the moduli at the current solid fraction times the elastic strain increment,
     s_tr = dev(sigma_n) + 2 mu dev(d eps_e), p = p_n + K tr(d eps_e), d eps_e = d eps - d e_iso
     1. A change of moduli (melting, freezing) then leaves the stress continuous: a melt freezes
     in the shape it has, instead of the stiffer solid pulling it back towards the stress-free
-    start (which the total form, eq. 38-39, does). Returns (sigma, eps_pl, alpha)."""
+    start (which the total form, eq. 38-39, does). Returns (sigma, dgamma, n): the stress and
+    the plastic multiplier and direction (dgamma = 0: elastic)."""
     E, nu = moduli(mp, xi)
     mu = E / (2.0 * (1.0 + nu))
     K = E / (3.0 * (1.0 - 2.0 * nu))
@@ -106,44 +110,48 @@ def perzyna_increment(
     tr = de.trace()
     p = sigma.trace() / 3.0 + K * tr
     s = (sigma - sigma.trace() / 3.0 * I3) + 2.0 * mu * (de - tr / 3.0 * I3)
+    dgam = 0.0
+    n = ti.Matrix.zero(float, 3, 3)
     if ti.static(plastic):
-        s, eps_pl, alpha = perzyna_return(mp, s, eps_pl, alpha, mu, xi, T, dt)
-    return p * I3 + s, eps_pl, alpha
+        s, dgam, n = perzyna_return(mp, s, alpha, mu, xi, T, dt)
+    return p * I3 + s, dgam, n
 
 
 @ti.func
 def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
     """Strain increment (eqs. 16-17, 34) and the Perzyna update (eqs. 38-45) of point p, in the
     total form (stress from the accumulated elastic strain, the paper's) or the incremental one
-    (``solver.stress_form``)."""
+    (``solver.stress_form``; it needs neither the accumulated strain nor the plastic strain,
+    which it then touches only where the point yields)."""
     deps = 0.5 * (L + L.transpose()) * dt
-    eps = pt.strain[p] + deps
-    pt.strain[p] = eps
-    sig = ti.Matrix.zero(float, 3, 3)
-    epl = pt.plastic_strain[p]
-    a = pt.equivalent_plastic_strain[p]
     if ti.static(cfg.stress_form == StressForm.INCREMENTAL):
         d_iso = 0.0
         if ti.static(cfg.th_strain):
             d_iso = pt.iso_strain_step[p]
-        sig, epl, a = perzyna_increment(
+        sig, dgam, n = perzyna_increment(
             mat[pt.material[p]],
             pt.stress[p],
             embed3(deps),
             d_iso,
-            epl,
-            a,
+            pt.equivalent_plastic_strain[p],
             pt.solid_fraction[p],
             pt.T[p],
             dt,
             cfg.plastic,
         )
+        pt.stress[p] = sig
+        if ti.static(cfg.plastic):
+            if dgam > 0.0:
+                pt.plastic_strain[p] += dgam * n
+                pt.equivalent_plastic_strain[p] += SQRT23 * dgam
     else:
+        eps = pt.strain[p] + deps
+        pt.strain[p] = eps
         sig, epl, a = perzyna_update(
             mat[pt.material[p]],
             embed3(eps),
-            epl,
-            a,
+            pt.plastic_strain[p],
+            pt.equivalent_plastic_strain[p],
             pt.iso_strain[p],
             pt.solid_fraction[p],
             pt.T[p],
@@ -151,9 +159,9 @@ def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, 
             cfg.plastic,
             cfg.stress_reading,
         )
-    pt.stress[p] = sig
-    pt.plastic_strain[p] = epl
-    pt.equivalent_plastic_strain[p] = a
+        pt.stress[p] = sig
+        pt.plastic_strain[p] = epl
+        pt.equivalent_plastic_strain[p] = a
 
 
 @ti.func

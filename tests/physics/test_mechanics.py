@@ -230,11 +230,11 @@ def test_incremental_stress_is_continuous_when_the_moduli_change():
         d = embed3(ti.Matrix([[1e-4, 3e-5], [3e-5, -2e-5]]))
         sig = z
         for _ in range(20):
-            sig = perzyna_increment(mat[0], sig, d, 0.0, z, 0.0, 0.0, 500.0, 1e-3, False)[0]
+            sig = perzyna_increment(mat[0], sig, d, 0.0, 0.0, 0.0, 500.0, 1e-3, False)[0]
         total = perzyna_update(mat[0], 20.0 * d, z, 0.0, 0.0, 0.0, 500.0, 1e-3, False, MODEL)[0]
         out[0] = sig
         out[1] = total
-        out[2] = perzyna_increment(mat[0], sig, z, 0.0, z, 0.0, 1.0, 500.0, 1e-3, False)[0]
+        out[2] = perzyna_increment(mat[0], sig, z, 0.0, 0.0, 1.0, 500.0, 1e-3, False)[0]
         out[3] = perzyna_update(mat[0], 20.0 * d, z, 0.0, 0.0, 1.0, 500.0, 1e-3, False, MODEL)[0]
 
     run()
