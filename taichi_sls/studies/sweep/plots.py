@@ -1,11 +1,13 @@
 """Figures from a sweep's ``results.csv`` (matplotlib Agg, PNG).
 
-- :func:`plot_power`: the paper's Fig. 5, contact line at the end and peak temperature against
+- :func:`plot_power`: the paper's Fig. 5, the contact line at 1 ms (the paper's snapshot) and at
+  the end (a run to solidification: what the part keeps), and the peak temperature, against
   laser power (stationary rows at the most common spot radius, 50 um in the bundled sweeps);
 - :func:`plot_radius_scan`: Fig. 8, the same against spot radius (stationary rows at the most
   common power) and stationary against scanning beams at that power and 50 um, as bars;
-- :func:`plot_process_map`: laser power (y) against scan speed (x), coloured by contact-line
-  growth (final minus initial), with the melt line T_peak = T_m drawn as a contour.
+- :func:`plot_process_map`: laser power (y) against scan speed or spot radius (x), coloured by
+  the final neck's growth over the initial one, the verdict of each run marked (o fused, x not,
+  ? undecided), the melt line T_peak = T_m drawn as a contour.
 
 Each row's laser power, spot radius and speed, and its initial contact line, come from the case's
 own outputs (``OUT/<id>/case.toml``, ``OUT/<id>/summary.json``); without them, from the row's
@@ -40,11 +42,11 @@ DPI = 110
 
 def load_rows(results_csv: str | Path) -> list[dict[str, Any]]:
     """Rows of results.csv with ``P_W``, ``r0_um``, ``v_m_s``, ``contact0_um`` and ``melt_C``
-    added (None where unknown). Only rows with status complete or failed are returned."""
+    added (None where unknown). Only rows with status complete, max_time or failed."""
     path = Path(results_csv)
     rows = []
     for r in read_results(path):
-        if r.get("status") not in ("complete", "failed"):
+        if r.get("status") not in ("complete", "max_time", "failed"):
             continue
         folder = path.parent / str(r["id"])
         r = dict(r)
@@ -107,7 +109,11 @@ def _pair(fig: Figure, rows: list[dict], xkey: str, xlabel: str, title: str, axe
         for a in (a1, a2):
             a.text(0.5, 0.5, "no rows", ha="center", va="center", transform=a.transAxes)
         return
-    _series(a1, rows, xkey, "contact_line_um", "C0", "end of run")
+    if any(r.get("neck_1ms_um") not in (None, "") for r in rows):
+        _series(a1, rows, xkey, "neck_1ms_um", "C1", "at 1 ms")
+        _series(a1, rows, xkey, "neck_final_um", "C0", "end (refrozen)")
+    else:
+        _series(a1, rows, xkey, "contact_line_um", "C0", "end of run")
     c0 = [r["contact0_um"] for r in rows if r["contact0_um"] is not None]
     if c0:
         a1.axhline(float(np.mean(c0)), color="0.5", ls="--", lw=1, label="initial")
@@ -143,8 +149,13 @@ def plot_radius_scan(results_csv: str | Path, png: str | Path) -> Path:
     r0 = 50.0 if any(r["r0_um"] == 50.0 for r in at_P) else _mode([r["r0_um"] for r in at_P])
     bars = sorted((r for r in at_P if r["r0_um"] == r0), key=lambda r: r["v_m_s"])
     labels = ["stationary" if r["v_m_s"] == 0 else f"{r['v_m_s']:g} m/s" for r in bars]
+    final = (
+        "neck_final_um"
+        if any(r.get("neck_final_um") not in (None, "") for r in bars)
+        else ("contact_line_um")
+    )
     for ax, key, color, ylabel in (
-        (axes[1][0], "contact_line_um", "C0", "contact line at the end [um]"),
+        (axes[1][0], final, "C0", "contact line at the end [um]"),
         (axes[1][1], "T_peak_C", "C3", "peak temperature [C]"),
     ):
         if not bars:
@@ -164,43 +175,52 @@ def plot_radius_scan(results_csv: str | Path, png: str | Path) -> Path:
     return _save(fig, png)
 
 
-def plot_process_map(results_csv: str | Path, png: str | Path) -> Path:
-    """Power (y) against scan speed (x), coloured by contact-line growth; melt line contour."""
+def plot_process_map(results_csv: str | Path, png: str | Path, xkey: str = "v_m_s") -> Path:
+    """Power (y) against scan speed (``xkey = "v_m_s"``) or spot radius (``"r0_um"``), coloured
+    by the final neck's growth; the verdicts marked; the melt line T_peak = T_m as a contour."""
     rows = [
         r
         for r in load_rows(results_csv)
-        if r["P_W"] is not None and r["v_m_s"] is not None and r["contact0_um"] is not None
+        if r["P_W"] is not None and r[xkey] is not None and r["contact0_um"] is not None
     ]
+    if xkey == "r0_um":
+        rows = [r for r in rows if r["v_m_s"] == 0]
     fig = Figure(figsize=(6.4, 4.8), layout="constrained")
     ax = fig.subplots()
-    speeds = sorted({r["v_m_s"] for r in rows})
+    xs = sorted({r[xkey] for r in rows})
     powers = sorted({r["P_W"] for r in rows})
-    if len(speeds) < 2 or len(powers) < 2:
-        ax.text(0.5, 0.5, "needs 2+ speeds and powers", ha="center", transform=ax.transAxes)
+    if len(xs) < 2 or len(powers) < 2:
+        ax.text(0.5, 0.5, "needs 2+ values on each axis", ha="center", transform=ax.transAxes)
         return _save(fig, png)
-    growth = np.full((len(powers), len(speeds)), np.nan)
+    growth = np.full((len(powers), len(xs)), np.nan)
     tpeak = np.full_like(growth, np.nan)
-    failed = []
+    verdicts = []
+    neck = (
+        "neck_final_um"
+        if any(r.get("neck_final_um") not in (None, "") for r in rows)
+        else ("contact_line_um")
+    )
     for r in rows:
-        i, j = powers.index(r["P_W"]), speeds.index(r["v_m_s"])
-        growth[i, j] = _num(r, "contact_line_um") - r["contact0_um"]
+        i, j = powers.index(r["P_W"]), xs.index(r[xkey])
+        growth[i, j] = _num(r, neck) - r["contact0_um"]
         tpeak[i, j] = _num(r, "T_peak_C")
-        if r["status"] != "complete":
-            failed.append((r["v_m_s"], r["P_W"]))
+        fused = r.get("fused")
+        mark = {True: "o", False: "x", "True": "o", "False": "x"}.get(fused, "?")
+        verdicts.append((j, r["P_W"], mark if r["status"] == "complete" else "!"))
     lo, hi = float(np.nanmin(growth)), float(np.nanmax(growth))
     if lo >= 0:  # growth only: a sequential scale from zero
         scale = {"cmap": "Reds", "vmin": 0.0, "vmax": hi or 1.0}
     else:  # shrinking too: diverging, white at zero
         lim = max(-lo, hi)
         scale = {"cmap": "RdBu_r", "vmin": -lim, "vmax": lim}
-    # speeds as equally spaced columns labelled with their values (0, 1, 2, 4, 8 m/s)
-    X, Y = np.meshgrid(np.arange(len(speeds)), powers)
+    # the x values as equally spaced columns labelled with their values
+    X, Y = np.meshgrid(np.arange(len(xs)), powers)
     mesh = ax.pcolormesh(X, Y, growth, shading="nearest", **scale)
-    fig.colorbar(mesh, ax=ax, label="contact-line growth, final - initial [um]")
-    for i, P in enumerate(powers):
-        for j in range(len(speeds)):
-            if np.isfinite(growth[i, j]):
-                ax.text(j, P, f"{growth[i, j]:+.1f}", ha="center", va="center", fontsize=8)
+    fig.colorbar(mesh, ax=ax, label="neck growth, final - initial [um]")
+    for j, P, mark in verdicts:
+        i = powers.index(P)
+        text = f"{growth[i, j]:+.1f}" if np.isfinite(growth[i, j]) else ""
+        ax.text(j, P, f"{mark} {text}", ha="center", va="center", fontsize=8)
     melt = rows[0]["melt_C"]
     ok = np.isfinite(tpeak)
     if ok.all() and tpeak.min() < melt < tpeak.max():
@@ -210,13 +230,14 @@ def plot_process_map(results_csv: str | Path, png: str | Path) -> Path:
     else:
         why = "outside the map" if ok.all() else "grid incomplete"
         ax.text(0.01, 0.01, f"T_peak = T_m = {melt:g} C: {why}", transform=ax.transAxes)
-    for v, P in failed:
-        ax.plot(speeds.index(v), P, "kx", ms=10)
-    ax.set_xticks(range(len(speeds)), [f"{v:g}" for v in speeds])
-    ax.set(xlabel="scan speed [m/s] (0 = stationary)", ylabel="laser power [W]")
+    ax.set_xticks(range(len(xs)), [f"{v:g}" for v in xs])
+    xlabel = "scan speed [m/s] (0 = stationary)" if xkey == "v_m_s" else "spot radius r0 [um]"
+    ax.set(xlabel=xlabel, ylabel="laser power [W]")
     ax.set_title(
-        "Contact-line growth over the run" + (" (x: guard stopped)" if failed else ""),
-        fontsize=10,
+        "Neck kept after refreezing (o fused, x not, ? undecided, ! failed)"
+        if neck == "neck_final_um"
+        else "Contact-line growth over the run",
+        fontsize=9,
     )
     return _save(fig, png)
 
@@ -239,8 +260,10 @@ def draw_all(out_dir: str | Path) -> list[Path]:
         written.append(plot_power(csv_path, out / "fig5_power.png"))
     if any(r["v_m_s"] not in (0, None) for r in rows) or len({r["r0_um"] for r in rows}) >= 2:
         written.append(plot_radius_scan(csv_path, out / "fig8_radius_scan.png"))
-    cells = {(r["v_m_s"], r["P_W"]) for r in rows if None not in (r["v_m_s"], r["P_W"])}
-    n_v, n_P = len({c[0] for c in cells}), len({c[1] for c in cells})
-    if n_v >= 2 and n_P >= 2 and len(cells) == n_v * n_P:  # a complete power x speed grid
-        written.append(plot_process_map(csv_path, out / "process_map.png"))
+    for xkey, name in (("v_m_s", "process_map.png"), ("r0_um", "process_map_radius.png")):
+        sel = [r for r in rows if xkey == "v_m_s" or r["v_m_s"] == 0]
+        cells = {(r[xkey], r["P_W"]) for r in sel if None not in (r[xkey], r["P_W"])}
+        n_x, n_P = len({c[0] for c in cells}), len({c[1] for c in cells})
+        if n_x >= 2 and n_P >= 2 and len(cells) == n_x * n_P:  # a complete grid
+            written.append(plot_process_map(csv_path, out / name, xkey))
     return written

@@ -39,14 +39,16 @@ overrides (``set`` included), so the id is stable across restarts and machines; 
 ``OUT/results.csv`` (and ``OUT/results.parquet`` when pyarrow is importable) gets one row per
 finished case, rewritten atomically as results arrive. Columns: ``id``, every swept key (named by
 the key; empty where a case leaves it at the base value), the collected quantities (from the
-summary's ``final`` monitors, else its top level, e.g. ``steps``), ``status``, ``error`` and
-``wall_s`` (wall time of the whole case, compilation included). Status: ``complete``, ``failed``
-(the solver's guard stopped the run; its message in ``error``), ``interrupted`` or ``error`` (an
-exception, e.g. an override the loader refuses; the message in ``error``). No case stops the
-sweep.
+summary's ``final`` monitors, else its fusion ``outcome``, e.g. ``fused`` or ``neck_final_um``,
+else its top level, e.g. ``steps``), ``status``, ``error`` and ``wall_s`` (wall time of the
+whole case, compilation included). Status: ``complete``, ``max_time`` (a run to solidification
+that gave up), ``failed`` (the solver's guard stopped the run; its message in ``error``),
+``interrupted`` or ``error`` (an exception, e.g. an override the loader refuses; the message in
+``error``). No case stops the sweep.
 
 Restart: run the same command again. Cases whose id already has a row with a final status
-(``complete``, ``failed`` or ``error``: the solver is deterministic, so these would repeat) are
+(``complete``, ``max_time``, ``failed`` or ``error``: the solver is deterministic, so these would
+repeat) are
 skipped; ``interrupted`` rows and missing cases run. ``--retry`` reruns everything not
 ``complete``. Rows of cases no longer in the sweep file are kept.
 
@@ -72,16 +74,19 @@ from ...config.loading import add_set_argument
 from .results import read_results, write_results
 from .spec import Sweep, SweepError, load_sweep
 
-STATUS_FINAL = ("complete", "failed", "error")  # skipped on restart (without --retry)
+STATUS_FINAL = ("complete", "max_time", "failed", "error")  # skipped on restart (without --retry)
 
 
 def _collect(summary: dict[str, Any], names: list[str]) -> dict[str, Any]:
+    """The named quantities of a run: from its final monitors, else its fusion outcome, else
+    the summary's top level."""
     final = summary.get("final") or {}
+    outcome = summary.get("outcome") or {}
     out: dict[str, Any] = {}
     for n in names:
         if n in ("status", "error", "id", "wall_s"):
             continue
-        v = final.get(n, summary.get(n))
+        v = final.get(n, outcome.get(n, summary.get(n)))
         out[n] = v if isinstance(v, (int, float, str, bool)) or v is None else json.dumps(v)
     return out
 
