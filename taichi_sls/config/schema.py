@@ -15,20 +15,9 @@ from .bodies import Body, Disc
 from .errors import CaseError
 from .materials import Material
 from .model import Model, Pair
-from .sections import (
-    Boundary,
-    CaseInfo,
-    Domain,
-    Fusion,
-    Grid,
-    Laser,
-    Output,
-    Physics,
-    Solver,
-    SurfaceTension,
-    Thermal,
-    Time,
-)
+from .numerics import Solver, Time
+from .sections import Boundary, CaseInfo, Domain, Fusion, Grid, Laser, Output, Physics, Thermal
+from .surface import SurfaceTension
 
 MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
 

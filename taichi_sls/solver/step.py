@@ -140,15 +140,22 @@ def p2g(st: ti.template(), heat: ti.template(), geom: ti.template()):
 
 
 @ti.func
+def on_clock(st: ti.template(), flag: ti.template(), body: ti.template()):
+    """``body(st)`` when the clock's ``flag`` is set: a Python bool in the one-call-per-step
+    layouts (the stage compiles in or out), a runtime flag in the serial one."""
+    if ti.static(isinstance(flag, bool)):
+        if ti.static(flag):
+            body(st)
+    else:
+        if flag:
+            body(st)
+
+
+@ti.func
 def grid_temperature_stage(st: ti.template(), heat: ti.template(), geom: ti.template()):
     """The node temperatures of a heat step (before the heat flux needs them)."""
     if ti.static(st.cfg.thermal):
-        if ti.static(isinstance(heat, bool)):
-            if ti.static(heat):
-                _grid_temperature_loop(st)
-        else:
-            if heat:
-                _grid_temperature_loop(st)
+        on_clock(st, heat, _grid_temperature_loop)
 
 
 @ti.func
@@ -162,17 +169,20 @@ def surface_force(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(_energy(st)):
         surface_energy_force(st.cfg, st.box, st.nodes, st.scalars.t[None])
     if ti.static(_csf(st)):
-        if ti.static(isinstance(geom, bool)):
-            if ti.static(geom):
-                surface_geometry(st.cfg, st.box, st.nodes, st.surf)
-            else:
-                mass_gradient(st.cfg, st.box, st.nodes)
-        else:
-            if geom:
-                surface_geometry(st.cfg, st.box, st.nodes, st.surf)
-            else:
-                mass_gradient(st.cfg, st.box, st.nodes)
+        # the level set and curvature on their clock; the mass gradient every step
+        on_clock(st, geom, _csf_geometry)
+        on_clock(st, not geom if ti.static(isinstance(geom, bool)) else geom == 0, _csf_mass)
         csf_force(st.cfg, st.box, st.nodes, st.surf, st.scalars.t[None])
+
+
+@ti.func
+def _csf_geometry(st: ti.template()):
+    surface_geometry(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.func
+def _csf_mass(st: ti.template()):
+    mass_gradient(st.cfg, st.box, st.nodes)
 
 
 @ti.func
@@ -194,12 +204,7 @@ def _heat_flux_loop(st: ti.template()):
 @ti.func
 def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(st.cfg.thermal):
-        if ti.static(isinstance(heat, bool)):
-            if ti.static(heat):
-                _heat_flux_loop(st)
-        else:
-            if heat:
-                _heat_flux_loop(st)
+        on_clock(st, heat, _heat_flux_loop)
 
 
 @ti.func

@@ -1,0 +1,140 @@
+"""The ``[time]`` and ``[solver]`` tables: time step, clocks and stop rule; transfers, layouts,
+precision and the constitutive integration."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+from pydantic import BeforeValidator, Field
+
+from .model import Model
+
+
+def _auto_or_positive(v: Any) -> float | str:
+    if v == "auto" and isinstance(v, str):
+        return v
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ValueError('expected a positive number or "auto"')
+    if not v > 0:
+        raise ValueError("must be > 0")
+    return float(v)
+
+
+def _auto_or_count(v: Any) -> int | str:
+    if v == "auto" and isinstance(v, str):
+        return v
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ValueError('expected an integer >= 1 or "auto"')
+    return v
+
+
+# validated before the union sees them, so that the message says what is allowed
+AutoPositive = Annotated[float | str, BeforeValidator(_auto_or_positive)]
+AutoCount = Annotated[int | str, BeforeValidator(_auto_or_count)]
+
+
+class Time(Model):
+    dt_s: AutoPositive = Field(
+        "auto", description='time step (s), or "auto" from the stability limits'
+    )
+    end_s: float = Field(1e-3, gt=0, description='simulated end time (s) of stop = "end"')
+    stop: Literal["end", "solidified"] = Field(
+        "end",
+        description="end: run to end_s; solidified: once every laser is off, run until every "
+        "point is solid (T <= T_c) and the kinetic energy has fallen below "
+        "settled_kinetic_fraction of the surface energy, or to max_s (then marked max_time)",
+    )
+    max_s: float = Field(
+        0.5, gt=0, description='simulated time at which a stop = "solidified" run gives up (s)'
+    )
+    settled_kinetic_fraction: float = Field(
+        1e-4,
+        gt=0,
+        description="settled: kinetic energy (with the inertia scale) below this fraction of "
+        "gamma times the bodies' perimeter",
+    )
+    safety: float = Field(0.4, gt=0, description='fraction of the stability limit for "auto"')
+    allow_unstable_dt: bool = Field(False, description="let a fixed dt exceed the stability limit")
+    heat_every: AutoCount = Field(
+        "auto",
+        description="conduction and laser every N mechanical steps, with a heat step of N dt "
+        '(the thermal limit is ~100x the elastic one); "auto": the largest N with N dt <= '
+        "heat_step_fraction x the thermal limit; 1: every step",
+    )
+    heat_step_fraction: float = Field(
+        0.1,
+        gt=0,
+        le=1.0,
+        description="heat step as a fraction of the thermal stability limit for heat_every = "
+        '"auto"',
+    )
+
+
+class Solver(Model):
+    transfer: Literal["apic", "flip", "pic_flip"] = Field(
+        "pic_flip",
+        description="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + "
+        "(1-flip_ratio)*PIC",
+    )
+    update: Literal["usl", "musl"] = Field(
+        "usl",
+        description="usl: eqs. 14-17 as printed; musl: move points with the remapped grid "
+        "velocity (bounded on nearly empty nodes, but slows capillary flow)",
+    )
+    flip_ratio: float = Field(
+        0.9, ge=0, le=1, description="FLIP share of the pic_flip blend, in [0, 1]"
+    )
+    arch: Literal["cpu", "gpu"] = Field("cpu", description="Taichi backend")
+    layout: Literal["auto", "serial", "parallel", "blocks"] = Field(
+        "auto",
+        description="serial: many steps per kernel call, loops serialized (one core); "
+        "parallel: one call per step, every loop parallel with atomic scatters (GPU); blocks: "
+        "one call per step, the points sorted into blocks scattered in four colour passes "
+        "without atomics (every CPU core, the same result at any thread count); auto: parallel "
+        "on a GPU, blocks on a CPU from 20k points with more than one thread, else serial",
+    )
+    threads: int = Field(0, ge=0, description="CPU threads Taichi may use (0: every core)")
+    active_region: bool = Field(
+        True,
+        description="grid loops only over the nodes that material has reached (plus the "
+        "stencil, level-set band and smoothing margin); false: every node, every step",
+    )
+    precision: Literal["f64", "f32"] = Field("f64", description="floating point precision")
+    mass_scale: float = Field(
+        1.0,
+        ge=1.0,
+        description="inertia scale s >= 1: the momentum equation sees s times the mass (heat "
+        "capacity, weight and the thermal field keep the physical one); the elastic and "
+        "capillary time-step limits grow by sqrt(s). For slow viscous or quasi-static flow "
+        "(Ohnesorge >> 1); the kinetic_ratio monitor says when inertia starts to matter "
+        "(docs/speed.md)",
+    )
+    small_mass: float = Field(
+        1e-9, ge=0, description="nodes below this fraction of a full cell's mass are skipped"
+    )
+    stress_reading: Literal["model", "paper"] = Field(
+        "model",
+        description="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md); paper: eq. 39 "
+        'and p = lambda tr(eps) as printed (with stress_form = "total")',
+    )
+    stress_form: Literal["incremental", "total"] = Field(
+        "incremental",
+        description="total: the stress from the accumulated elastic strain at the current "
+        "moduli (eqs. 38-39: a melt that freezes, E rising tenfold, is pulled back towards its "
+        "stress-free start); incremental: the last stress plus the current moduli times the "
+        "strain increment (the stress stays continuous through melting and freezing)",
+    )
+    optimize: bool = Field(
+        False,
+        description="Taichi's advanced optimisation: ~1.5x faster steps after a ~100 s "
+        "one-off compile (cached on disk); false compiles in ~5-10 s",
+    )
+    fast_math: bool = Field(
+        True,
+        description="let the compiler reorder floating-point arithmetic (Taichi's fast_math); "
+        "false: strict IEEE order, bitwise reproducible across changes of code structure",
+    )
+    strain: Literal["small"] = Field(
+        "small", description="small: accumulated eps += sym(L) dt (eqs. 16-17; not objective)"
+    )
