@@ -131,6 +131,15 @@ def choose_layout(case: Case, n_points: int) -> Layout:
     return Layout.SERIAL
 
 
+def flip_share(case: Case, dt: float) -> float:
+    """The FLIP share of one step of the pic_flip blend (``solver.blend_per``): with "time",
+    flip_ratio^(dt / flip_ratio_dt_s), the same PIC damping per unit time at any step."""
+    sv = case.solver
+    if sv.blend_per == "step" or dt <= 0.0 or dt == sv.flip_ratio_dt_s:
+        return sv.flip_ratio
+    return sv.flip_ratio ** (dt / sv.flip_ratio_dt_s)
+
+
 def step_config(
     case: Case,
     scene: Scene,
@@ -175,7 +184,7 @@ def step_config(
         stress_reading=StressReading.PAPER if sv.stress_reading == "paper" else StressReading.MODEL,
         stress_form=StressForm[sv.stress_form.upper()],
         transfer=Transfer[sv.transfer.upper()],
-        flip_ratio=sv.flip_ratio,
+        flip_ratio=flip_share(case, dt),
         update=Update[sv.update.upper()],
         layout=layout,
         parallel=layout != Layout.SERIAL,

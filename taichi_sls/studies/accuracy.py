@@ -89,7 +89,6 @@ STUDIES = (
         (10, 20, 40),
         (10,),
         "decay_rate",
-        sets={"time": {"end_s": 6e-5}},
         transfers_at=(20,),
         csf_at=(10, 20, 40),
     ),
