@@ -6,7 +6,8 @@
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
-``python -m taichi_sls.run CASE ...`` is ``taichi-sls run CASE ...``.
+``python -m taichi_sls.run CASE ...`` is ``taichi-sls run CASE ...``; ``python -m taichi_sls.bench
+STUDY ...`` is ``taichi-sls bench STUDY ...``.
 """
 
 from __future__ import annotations
