@@ -7,6 +7,7 @@ inertia scale ``solver.mass_scale``, the grid -- is run, timed (stepping only, a
 compilation) and compared with a reference: for the paper case a converged run (a quarter of
 the paper's step, physical inertia), for the verification cases the exact solution. Writes
 ``cost_error.csv`` and ``cost_error.png`` (error against wall time) and prints the table.
+A paper run already complete under OUT/cost_runs/ is read, not run again (delete it to rerun).
 
 Inertia scaling is honest where inertia does not matter: in a slow viscous flow (Ohnesorge
 >> 1) the kinetic energy is a vanishing fraction of the surface and elastic energies, and
@@ -77,7 +78,10 @@ def _paper_row(label: str, sets: list[str], out: Path) -> dict:
     ]
     case = load_case("power25W", sets)
     folder = out / "cost_runs" / label.replace(" ", "_").replace(",", "").replace(":", "")
-    s = run_case(case, folder, progress=False)
+    summary = folder / "summary.json"
+    s = json.loads(summary.read_text()) if summary.is_file() else None
+    if s is None or s.get("status") != "complete":
+        s = run_case(case, folder, progress=False)
     o = s["outcome"]
     series = read_series(folder / "timeseries.csv")
     return {

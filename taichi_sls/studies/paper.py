@@ -1,6 +1,6 @@
 """Run every Table 2 case (fine and coarse) plus ``nolaser`` and tabulate what the paper reports.
 
-    taichi-sls bench paper [--out out/paper] [--optimize] [--only power25W ...]
+    taichi-sls bench paper [--out out/paper] [--optimize] [--only power25W ...] [--plots]
         [--set key=value ...]
 
 Each case writes its usual outputs to OUT/<case>/ (a case already complete there is read, not run
@@ -8,6 +8,7 @@ again). Prints a Markdown table and writes OUT/table.csv: peak temperature, cont
 start, at 1 ms, when refrozen and at the end, neck span, the verdict, status, steps and wall time
 (``--set time.stop=solidified`` runs every case until it has refrozen). ``--optimize``
 compiles with Taichi's advanced optimisation (about 100 s once, then 1.5x faster steps).
+``--plots`` draws Figs. 5 and 8 from the fine cases (nolaser as 0 W) into OUT.
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap.add_argument("--out", default="out/paper", help="folder for the runs and table.csv")
     ap.add_argument("--optimize", action="store_true", help="Taichi's advanced optimisation")
     ap.add_argument("--only", nargs="*", metavar="CASE", help="only these cases")
+    ap.add_argument(
+        "--plots", action="store_true", help="draw Figs. 5 and 8 from the fine cases into OUT"
+    )
     add_set_argument(ap, "case override for every case")
     ap.set_defaults(func=main)
 
@@ -59,6 +63,22 @@ def _row(name: str, s: dict) -> dict:
     }
 
 
+def _figures(out: Path, rows: list[dict]) -> None:
+    """Figs. 5 and 8 from the fine cases and nolaser (0 W), through the sweep's plots: their
+    rows as OUT/results.csv, one id per case folder."""
+    from .sweep.plots import draw_all
+    from .sweep.results import write_results
+
+    fine = [
+        {**r, "id": r["case"], "neck_final_um": r["contact_line_end_um"]}
+        for r in rows
+        if not r["case"].endswith("_coarse")
+    ]
+    write_results(out, fine, ["id", "status", "T_peak_C", "neck_1ms_um", "neck_final_um", "fused"])
+    for p in draw_all(out):
+        print(f"wrote {p}")
+
+
 def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     names = [b + s for s in ("", "_coarse") for b in BASES] + ["nolaser"]
@@ -78,6 +98,8 @@ def main(args: argparse.Namespace) -> int:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+    if args.plots:
+        _figures(out, rows)
     keys = list(rows[0])
     print("| " + " | ".join(keys) + " |")
     print("|" + "---|" * len(keys))

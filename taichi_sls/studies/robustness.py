@@ -1,8 +1,9 @@
 """The robustness matrix: ``taichi-sls robustness [--quick] [--out out/robustness]``.
 
 Runs a matrix of cases at the edge of stability -- time step from 0.25x to 4x the automatic
-limit, laser power 1 to 100 W, grid spacing 4 to 0.5 um, a 10 ms run, very soft and very stiff
-materials, a body touching every wall -- and classifies each row:
+limit, laser power 1 to 100 W, grid spacing 4 to 0.5 um, 10 ms and 40 ms runs, inertia scales
+64 and 1024, APIC, the paper's CSF and total stress form, very soft and very stiff materials, a
+body touching every wall -- and classifies each row:
 
 - ``stable``: ran to its end, the guard silent, and the independent checks below pass;
 - ``caught``: the guard stopped it (its message is recorded);
@@ -61,6 +62,19 @@ def matrix() -> list[Row]:
     rows += [
         Row("10 ms, 25 W", "power25W_coarse", ["time.end_s=1e-2"]),
         Row("10 ms, no laser", "power25W_coarse", ["time.end_s=1e-2", "lasers.0.power_W=0"]),
+        Row("40 ms, 25 W (refrozen)", "power25W_coarse", ["time.end_s=4e-2"]),
+    ]
+    rows += [
+        Row(f"inertia scale {s}", "power25W_coarse", [f"solver.mass_scale={s}", "time.end_s=5e-4"])
+        for s in (64, 1024)
+    ]
+    rows += [
+        Row(name, "power25W_coarse", [key, "time.end_s=5e-4"])
+        for name, key in (
+            ("APIC", "solver.transfer=apic"),
+            ("the paper's CSF", "surface_tension.method=csf"),
+            ("total stress form", "solver.stress_form=total"),
+        )
     ]
     soft = ["materials.PA12.youngs_solid_Pa=1e3", "materials.PA12.youngs_liquid_Pa=1e2"]
     stiff = ["materials.PA12.youngs_solid_Pa=1e7", "materials.PA12.youngs_liquid_Pa=1e6"]

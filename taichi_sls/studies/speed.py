@@ -93,7 +93,7 @@ def field_bytes(obj: object) -> int:
     total = 0
     for v in vars(obj).values():
         if isinstance(v, ti.lang.struct.StructField):
-            total += sum(field_bytes_of(m) for m in v._items)
+            total += sum(field_bytes_of(getattr(v, k)) for k in v.keys)
         elif isinstance(v, ti.Field):
             total += field_bytes_of(v)
         elif hasattr(v, "__dict__") and type(v).__module__.startswith("taichi_sls"):
