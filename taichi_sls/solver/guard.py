@@ -73,8 +73,11 @@ class Guard:
                 hint,
             )
         elif internal["trouble"] == Trouble.LEFT_GRID:
-            x = pt.x.to_numpy()
-            r = np.abs(x - np.array([st.scene.width, st.scene.height]) / 2).max(axis=1)
+            # how far each point lies beyond the grid's reach (the bounds of monitor.py)
+            x, cfg = pt.x.to_numpy(), st.cfg
+            lo = -(cfg.off - 1) * cfg.h
+            hi = np.array([cfg.nx - cfg.off - 2, cfg.ny - cfg.off - 2]) * cfg.h
+            r = np.maximum(lo - x, x - hi).max(axis=1)
             problem = (f"a point left the grid: {self._where(r)}", hint)
         elif mon["J_min"] <= 0.0:
             problem = (

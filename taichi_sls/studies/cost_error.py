@@ -127,18 +127,20 @@ def _verification_rows(quick: bool) -> list[dict]:
     return rows
 
 
-def _errors(rows: list[dict]) -> None:
+def errors(rows: list[dict]) -> None:
     """The paper rows' errors against the reference row (relative)."""
     ref = next(r for r in rows if r["setting"].startswith("reference"))
     for r in rows:
         if r["scenario"] != ref["scenario"]:
             continue
-        for k in ("neck_1ms_um", "neck_final_um", "T_peak_C"):
-            a, b = r.get(k), ref.get(k)
+        for key, err in (
+            ("neck_1ms_um", "err_1ms"),
+            ("neck_final_um", "err_final"),
+            ("T_peak_C", "err_T"),
+        ):
+            a, b = r.get(key), ref.get(key)
             ok = a is not None and b is not None and b != 0
-            r["err_" + k.removesuffix("_um").removesuffix("_C")] = (
-                abs(a / b - 1) if ok else math.nan
-            )
+            r[err] = abs(a / b - 1) if ok else math.nan
         r["error"] = max(r["err_1ms"], r["err_final"], r["err_T"])
 
 
@@ -184,7 +186,7 @@ def main(args: argparse.Namespace) -> int:
             continue
         rows.append(_paper_row(label, [*sets, *args.set], out))
         print(rows[-1], file=sys.stderr, flush=True)
-    _errors(rows)
+    errors(rows)
     if not args.skip_verification:
         rows += _verification_rows(args.quick)
     with (out / "cost_error.csv").open("w", newline="") as f:

@@ -12,6 +12,7 @@ import argparse
 import csv
 import json
 import math
+import resource
 import time
 from pathlib import Path
 
@@ -126,6 +127,11 @@ def timed(fn, per_call: int, seconds: float, warm: int = 1) -> tuple[float, int]
             return best, steps
 
 
+def peak_rss_mb() -> float:
+    """The process's peak resident memory so far (MB): every field and Taichi's own share."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def _per_call(n_points: int) -> int:
     return max(1, min(200, 500_000 // max(n_points, 1)))
 
@@ -167,7 +173,11 @@ def measure_scene(label: str, case: Case, seconds: float, compare: bool) -> list
     st = s.state
     auto = (st.cfg.layout.name.lower(), 0 if st.cfg.parallel and case.solver.threads != 1 else 1)
     t_full, k = _time_state(s, seconds)
-    extra = {"bytes_per_point": field_bytes(st) / st.n_points, "compile_s": s.compile_s}
+    extra = {
+        "bytes_per_point": field_bytes(st) / st.n_points,
+        "compile_s": s.compile_s,
+        "peak_rss_MB": peak_rss_mb(),
+    }
     rows = [_row(label, st, _variant(*auto) + " (auto)", t_full, k, ratio=1.0, **extra)]
     if not compare:
         return rows
@@ -282,6 +292,7 @@ COLUMNS = [
     "speedup",
     "bytes_per_point",
     "compile_s",
+    "peak_rss_MB",
     "steps",
 ]
 

@@ -147,6 +147,22 @@ def test_guard_names_the_point_that_went_nan():
         raise AssertionError("the guard let a NaN temperature through")
 
 
+def test_guard_names_the_point_that_left_the_grid():
+    """A point thrown out of the open top is the one named, not the point farthest from the
+    domain's centre (a point on a side wall is farther from the centre of a wide domain)."""
+    sim = Simulation(_small())
+    x = sim.state.points.x.to_numpy()
+    cfg = sim.state.cfg
+    x[5, 1] = (cfg.ny - cfg.off - 1.5) * cfg.h  # half a cell beyond the grid's reach, on top
+    sim.state.points.x.from_numpy(x)
+    try:
+        sim.monitors()
+    except SimulationError as e:
+        assert "left the grid" in str(e) and "point 5 " in str(e)
+    else:
+        raise AssertionError("the guard let a point beyond the grid through")
+
+
 def test_unwritable_out_is_one_line_error(tmp_path, capsys):
     from taichi_sls.cli import run_main
 

@@ -51,3 +51,35 @@ def test_speed_bench_writes_its_table(tmp_path):
     assert {"full physics", "one kernel call per stage", "minimal elastic MLS-MPM"} <= variants
     assert all(float(r["us_per_step"]) > 0 for r in rows)
     assert (tmp_path / "speed.png").stat().st_size > 0
+
+
+def test_cost_errors_are_relative_to_the_reference_row():
+    """The run-time/error study: each paper row's errors are relative to the reference row's
+    neck at 1 ms, final neck and peak temperature; its error is the largest of the three, and
+    rows of other scenarios keep their own error."""
+    from taichi_sls.studies.cost_error import errors
+
+    paper = "paper 25 W to solidification"
+    rows = [
+        {
+            "scenario": paper,
+            "setting": "reference: dt",
+            "neck_1ms_um": 20.0,
+            "neck_final_um": 21.0,
+            "T_peak_C": 300.0,
+        },
+        {
+            "scenario": paper,
+            "setting": "dt x2",
+            "neck_1ms_um": 20.2,
+            "neck_final_um": 21.0,
+            "T_peak_C": 303.0,
+        },
+        {"scenario": "hopper R/h = 10", "setting": "auto dt, s = 1", "error": 0.05},
+    ]
+    errors(rows)
+    assert rows[0]["error"] == 0.0
+    assert rows[1]["err_1ms"] == pytest.approx(0.01)
+    assert rows[1]["err_final"] == 0.0
+    assert rows[1]["error"] == pytest.approx(0.01)
+    assert rows[2]["error"] == 0.05
