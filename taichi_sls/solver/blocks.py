@@ -22,6 +22,10 @@ import taichi as ti
 SIDE = 12  # cells per block side
 MARGIN = 3  # cells a point may leave its block by (the stencils reach 3 nodes: SIDE > 2 MARGIN + 4)
 COLOURS = 4
+# Taichi's CPU range-for hands each thread tasks of at least 512 iterations, so a loop over a
+# few hundred blocks would run on one thread: each block's loop index is spread over SPREAD
+# iterations (one does the work) so that every loop over blocks has this many.
+LOOP_ITERATIONS = 8192
 
 
 def block_of(x: np.ndarray, h: float, off: int, n_bx: int) -> np.ndarray:
@@ -55,6 +59,7 @@ class BlockPlan:
             table[c, : len(ls)] = ls
             self.n_colour[c] = len(ls)
         self.by_colour.from_numpy(table)
+        self.spread = -(-LOOP_ITERATIONS // max(1, min(self.n_colour)))
         self.colour_sizes = ti.field(ti.i32, COLOURS)
         self.colour_sizes.from_numpy(np.array(self.n_colour, dtype=np.int32))
         # per-block accumulators of the step (block-owned: plain adds)

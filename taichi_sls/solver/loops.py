@@ -26,16 +26,20 @@ def point_loop(
     """``body`` for every point. ``scatter``: the body writes to the nodes around its point, so
     in the blocks layout it runs colour by colour."""
     if ti.static(blocks(st)):
+        spread = ti.static(st.blocks.spread)  # blocks.LOOP_ITERATIONS: every thread gets work
         if ti.static(scatter):
             for c in ti.static(range(4)):
-                for k in range(ti.static(st.blocks.n_colour[c])):
-                    b = st.blocks.by_colour[c, k]
+                for j in range(ti.static(st.blocks.n_colour[c] * spread)):
+                    if j % spread == 0:
+                        b = st.blocks.by_colour[c, j // spread]
+                        for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
+                            body(st, p, b, heat, geom)
+        else:
+            for j in range(st.blocks.n_blocks * spread):
+                if j % spread == 0:
+                    b = j // spread
                     for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
                         body(st, p, b, heat, geom)
-        else:
-            for b in range(st.blocks.n_blocks):
-                for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
-                    body(st, p, b, heat, geom)
     else:
         for p in range(st.cfg.n_points):
             body(st, p, 0, heat, geom)
