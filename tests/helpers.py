@@ -11,7 +11,7 @@ PAPER_SCENE = {
     ],
 }
 
-__all__ = ["PAPER_SCENE", "deep_update", "make_case"]
+__all__ = ["PAPER_SCENE", "deep_update", "guard_message", "make_case", "neck_and_kinetic_energy"]
 
 
 def make_case(data: dict):
@@ -30,3 +30,31 @@ def material_field(m):
     f = material_struct().field(shape=1)
     f.from_numpy({k: np.array([v]) for k, v in material_values(m, 0.0).items()})
     return f
+
+
+def neck_and_kinetic_energy(sim, every_s: float, frames: int) -> tuple[list, list]:
+    """The contact line (um) and kinetic energy (J/m) after each of ``frames`` advances of
+    ``every_s``, printed for the test log."""
+    n = round(every_s / sim.dt)
+    lines, ke = [], []
+    for _ in range(frames):
+        sim.advance(n)
+        m = sim.monitors()
+        lines.append(m["contact_line_um"])
+        ke.append(m["kinetic_energy_J_per_m"])
+    print("contact line (um):", [round(c, 3) for c in lines], "KE:", [f"{k:.1e}" for k in ke])
+    return lines, ke
+
+
+def guard_message(sim, frames: int = 1, steps: int = 0) -> str | None:
+    """The guard's message at the first of ``frames`` checks (each after ``steps`` steps) that
+    stops the run, or None if none does."""
+    from taichi_sls.solver.guard import SimulationError
+
+    for _ in range(frames):
+        sim.advance(steps)
+        try:
+            sim.monitors()
+        except SimulationError as e:
+            return str(e)
+    return None

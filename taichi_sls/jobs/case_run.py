@@ -207,6 +207,14 @@ def run_case(
     return summary
 
 
+def complete_summary(out_dir: Path) -> dict[str, Any] | None:
+    """The summary of a run already complete in out_dir, else None: the studies run again only
+    what is missing (delete the folder to rerun)."""
+    path = Path(out_dir) / "summary.json"
+    summary = json.loads(path.read_text()) if path.is_file() else None
+    return summary if summary is not None and summary.get("status") == "complete" else None
+
+
 def print_outcome(summary: dict[str, Any]) -> None:
     """The outcome lines of a finished run, on stderr."""
     print(describe(summary["outcome"]), file=sys.stderr)

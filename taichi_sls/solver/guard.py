@@ -9,7 +9,7 @@ import numpy as np
 
 from ..physics.materials import KELVIN
 from .fields import NEVER, WATCHED, State
-from .monitor import Trouble
+from .monitor import Trouble, grid_reach
 from .step_config import T_RUNAWAY_K
 
 
@@ -73,11 +73,10 @@ class Guard:
                 hint,
             )
         elif internal["trouble"] == Trouble.LEFT_GRID:
-            # how far each point lies beyond the grid's reach (the bounds of monitor.py)
-            x, cfg = pt.x.to_numpy(), st.cfg
-            lo = -(cfg.off - 1) * cfg.h
-            hi = np.array([cfg.nx - cfg.off - 2, cfg.ny - cfg.off - 2]) * cfg.h
-            r = np.maximum(lo - x, x - hi).max(axis=1)
+            # how far each point lies beyond the grid's reach
+            lo, hi_x, hi_y = grid_reach(st.cfg)
+            x = pt.x.to_numpy()
+            r = np.maximum(lo - x, x - np.array([hi_x, hi_y])).max(axis=1)
             problem = (f"a point left the grid: {self._where(r)}", hint)
         elif mon["J_min"] <= 0.0:
             problem = (

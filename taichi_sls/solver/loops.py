@@ -31,18 +31,23 @@ def point_loop(
             for c in ti.static(range(4)):
                 for j in range(ti.static(st.blocks.n_colour[c] * spread)):
                     if j % spread == 0:
-                        b = st.blocks.by_colour[c, j // spread]
-                        for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
-                            body(st, p, b, heat, geom)
+                        block_points(st, st.blocks.by_colour[c, j // spread], body, heat, geom)
         else:
             for j in range(st.blocks.n_blocks * spread):
                 if j % spread == 0:
-                    b = j // spread
-                    for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
-                        body(st, p, b, heat, geom)
+                    block_points(st, j // spread, body, heat, geom)
     else:
         for p in range(st.cfg.n_points):
             body(st, p, 0, heat, geom)
+
+
+@ti.func
+def block_points(
+    st: ti.template(), b, body: ti.template(), heat: ti.template(), geom: ti.template()
+):
+    """``body`` for the points of block b, in their sorted order (one thread)."""
+    for p in range(st.blocks.start[b], st.blocks.start[b] + st.blocks.count[b]):
+        body(st, p, b, heat, geom)
 
 
 @ti.func

@@ -30,6 +30,16 @@ class Trouble(IntEnum):
     LEFT_GRID = 2  # a point beyond the ghost layer
 
 
+def grid_reach(cfg) -> tuple[float, float, float]:
+    """(lowest x and y, highest x, highest y) in m that a point may reach with its stencil
+    inside the arrays; beyond them it has left the grid (Trouble.LEFT_GRID)."""
+    return (
+        -float(cfg.off - 1) * cfg.h,
+        float(cfg.nx - cfg.off - 2) * cfg.h,
+        float(cfg.ny - cfg.off - 2) * cfg.h,
+    )
+
+
 @ti.kernel
 def reduce_points(st: ti.template()):
     """The totals of the points (fields.TOTALS)."""
@@ -45,9 +55,7 @@ def reduce_points(st: ti.template()):
     tot.enthalpy[None] = 0.0
     tot.kinetic_energy[None] = 0.0
     tot.trouble[None] = 0.0
-    lo = -ti.cast(st.cfg.off - 1, float) * st.cfg.h
-    hi_x = ti.cast(st.cfg.nx - st.cfg.off - 2, float) * st.cfg.h
-    hi_y = ti.cast(st.cfg.ny - st.cfg.off - 2, float) * st.cfg.h
+    lo, hi_x, hi_y = ti.static(grid_reach(st.cfg))
     # serial: float sums in a fixed order, so that monitors repeat bit for bit (resume test);
     # it runs once per output frame
     ti.loop_config(serialize=True)

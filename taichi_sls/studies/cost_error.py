@@ -67,7 +67,7 @@ COLUMNS = [
 
 def _paper_row(label: str, sets: list[str], out: Path) -> dict:
     from ..io.series import read_series
-    from ..jobs.case_run import run_case
+    from ..jobs.case_run import complete_summary, run_case
 
     sets = [
         *sets,
@@ -78,10 +78,7 @@ def _paper_row(label: str, sets: list[str], out: Path) -> dict:
     ]
     case = load_case("power25W", sets)
     folder = out / "cost_runs" / label.replace(" ", "_").replace(",", "").replace(":", "")
-    summary = folder / "summary.json"
-    s = json.loads(summary.read_text()) if summary.is_file() else None
-    if s is None or s.get("status") != "complete":
-        s = run_case(case, folder, progress=False)
+    s = complete_summary(folder) or run_case(case, folder, progress=False)
     o = s["outcome"]
     series = read_series(folder / "timeseries.csv")
     return {

@@ -44,6 +44,9 @@ RUNS = [
 ]
 
 
+MONITORS = ("contact_line_um", "kinetic_energy_J_per_m", "J_min", "T_peak_C")
+
+
 def run_one(case_name: str, sets: list[str], end_s: float, every_s: float) -> list[dict]:
     """The monitors every ``every_s``; a run the guard stops ends with a row that says so."""
     from ..config import load_case
@@ -54,26 +57,21 @@ def run_one(case_name: str, sets: list[str], end_s: float, every_s: float) -> li
     sim = Simulation(case)
     n = round(every_s / sim.dt)
     rows = []
-    for k in range(round(end_s / every_s) + 1):
+    last = round(end_s / every_s)
+    for k in range(last + 1):
         try:
             if k:
                 sim.advance(n)
             m = sim.monitors()
         except SimulationError as e:
-            nan = float("nan")
-            rows.append({**dict.fromkeys(rows[0], nan), "t_us": round(sim.t * 1e6, 3)})
-            rows[-1]["status"] = f"failed: {e}"
-            return rows
+            m, status = dict.fromkeys(MONITORS, float("nan")), f"failed: {e}"
+        else:
+            status = "running" if k < last else "complete"
         rows.append(
-            {
-                "t_us": round(sim.t * 1e6, 3),
-                "contact_line_um": m["contact_line_um"],
-                "kinetic_energy_J_per_m": m["kinetic_energy_J_per_m"],
-                "J_min": m["J_min"],
-                "T_peak_C": m["T_peak_C"],
-                "status": "running" if k < round(end_s / every_s) else "complete",
-            }
+            {"t_us": round(sim.t * 1e6, 3), **{key: m[key] for key in MONITORS}, "status": status}
         )
+        if status.startswith("failed"):
+            break
     return rows
 
 

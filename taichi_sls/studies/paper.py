@@ -15,12 +15,11 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
 from pathlib import Path
 
 from ..config import load_case
 from ..config.loading import add_set_argument
-from ..jobs.case_run import run_case
+from ..jobs.case_run import complete_summary, run_case
 
 BASES = ["power5W", "power15W", "power25W", "radius30um", "radius70um", "scan4mps"]
 
@@ -87,9 +86,8 @@ def main(args: argparse.Namespace) -> int:
     rows = []
     for name in names:
         folder = out / name
-        summ = folder / "summary.json"
-        s = json.loads(summ.read_text()) if summ.is_file() else None
-        if s is None or s.get("status") != "complete":
+        s = complete_summary(folder)
+        if s is None:
             sets = (["solver.optimize=true"] if args.optimize else []) + args.set
             case = load_case(name, sets)
             s = run_case(case, folder, progress=False)

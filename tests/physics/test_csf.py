@@ -4,7 +4,7 @@ start; the nolaser pair."""
 
 import numpy as np
 import pytest
-from helpers import PAPER_SCENE, deep_update, make_case
+from helpers import PAPER_SCENE, deep_update, make_case, neck_and_kinetic_energy
 
 from taichi_sls.config import load_case
 from taichi_sls.solver.monitor import column_material_length, neck_measures
@@ -183,14 +183,7 @@ def test_nolaser_neck_holds_and_kinetic_energy_decays():
     contact line stays within 2 % of its start (measured: 8.27 -> 8.27-8.40 um) and the kinetic
     energy does not grow from noise (measured: 3.1e-10 J/m at 0.1 ms, 3.9e-13 J/m at 1 ms)."""
     sim = Simulation(load_case("nolaser", ["surface_tension.method=csf"]))
-    n = round(1e-4 / sim.dt)
     m0 = sim.monitors()
-    lines, ke = [], []
-    for _ in range(10):
-        sim.advance(n)
-        m = sim.monitors()
-        lines.append(m["contact_line_um"])
-        ke.append(m["kinetic_energy_J_per_m"])
-    print("contact line (um):", [round(c, 3) for c in lines], "KE:", [f"{k:.1e}" for k in ke])
+    lines, ke = neck_and_kinetic_energy(sim, 1e-4, 10)
     assert max(abs(c / m0["contact_line_um"] - 1.0) for c in lines) < 0.02
     assert ke[-1] < ke[0] and ke[-1] < 1e-11

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import deep_update
+from helpers import deep_update, neck_and_kinetic_energy
 
 from taichi_sls.config import CaseError, case_from_dict, load_case
 from taichi_sls.solver.scene import build_scene, inside_polygon
@@ -185,14 +185,7 @@ def test_nolaser_pair_adheres_then_holds():
     0.1 ms to 1 ms, kinetic energy 1e-12 J/m at the end. Tolerances: the neck within 1 % from
     0.1 ms on and the kinetic energy decaying below 1e-11 J/m."""
     sim = Simulation(load_case("nolaser"))
-    n = round(1e-4 / sim.dt)
-    lines, ke = [], []
-    for _ in range(10):
-        sim.advance(n)
-        m = sim.monitors()
-        lines.append(m["contact_line_um"])
-        ke.append(m["kinetic_energy_J_per_m"])
-    print("contact line (um):", [round(c, 3) for c in lines], "KE:", [f"{k:.1e}" for k in ke])
+    lines, ke = neck_and_kinetic_energy(sim, 1e-4, 10)
     assert max(lines) / min(lines) - 1.0 < 0.01
     assert ke[-1] < ke[0] and ke[-1] < 1e-11
 
