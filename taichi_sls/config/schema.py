@@ -16,7 +16,18 @@ from .errors import CaseError
 from .materials import Material
 from .model import Model, Pair
 from .numerics import Solver, Time
-from .sections import Boundary, CaseInfo, Domain, Fusion, Grid, Laser, Output, Physics, Thermal
+from .sections import (
+    Boundary,
+    CaseInfo,
+    Contact,
+    Domain,
+    Fusion,
+    Grid,
+    Laser,
+    Output,
+    Physics,
+    Thermal,
+)
 from .surface import SurfaceTension
 
 MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
@@ -45,6 +56,7 @@ class Case(Model):
     surface_tension: SurfaceTension = Field(default_factory=SurfaceTension)
     output: Output = Field(default_factory=Output)
     fusion: Fusion = Field(default_factory=Fusion)
+    contact: Contact = Field(default_factory=Contact)
 
     @model_validator(mode="before")
     @classmethod

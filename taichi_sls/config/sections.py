@@ -22,6 +22,13 @@ class Grid(Model):
         le=8,
         description="material points per cell along each axis (2 -> 2x2 quarter points)",
     )
+    seeding: Literal["centre", "area"] = Field(
+        "centre",
+        description="centre: a point is kept where its centre lies in a body, with the volume "
+        "of its whole square (an outline seeded as a staircase, +-1/2 point spacing); area: a "
+        "point is kept where its square touches a body, with the volume of the part inside (the "
+        "outline and a narrow neck seeded to second order; solver/scene.py)",
+    )
     ghost_cells: int = Field(
         1,
         ge=0,
@@ -74,8 +81,20 @@ class Fusion(Model):
     neck_growth: float = Field(
         0.05,
         ge=0,
-        description="fused: the neck at the end exceeds the initial one by this fraction and the "
+        description="fused: the refrozen neck exceeds the baseline neck by this fraction and the "
         "neck region melted through",
+    )
+    baseline: Literal["unheated", "initial"] = Field(
+        "unheated",
+        description="the neck that growth is measured against: unheated, the neck of the same "
+        "case run without laser heat for baseline_s (a soft solid with a surface energy adheres "
+        "and grows its contact unheated; jobs/unheated.py); initial: the neck at t = 0",
+    )
+    baseline_s: float = Field(
+        2e-4,
+        gt=0,
+        description="unheated baseline: simulated time of the unheated run (s); the adhesive "
+        "contact settles within some 50 us",
     )
     neck_region_cells: float = Field(
         1.0,
@@ -89,6 +108,32 @@ class Fusion(Model):
         le=1,
         description="melted through: this fraction of the neck region's points was fully molten "
         "(above T_m) at some time",
+    )
+
+
+class Contact(Model):
+    """How touching bodies meet at the start, and how their necks are read."""
+
+    initial: Literal["fillet", "point"] = Field(
+        "point",
+        description="fillet: every pair of discs closer than twice fillet_radius_um is joined "
+        "by the bridge that two fillet circles of that radius, tangent to both discs, cut off "
+        "(a finite neck whose outline does not depend on h; solver/contacts.py); point: the "
+        "discs as seeded (touching discs meet at one point, a neck the grid sets)",
+    )
+    fillet_radius_um: float = Field(
+        2.0,
+        gt=0,
+        description="fillet: radius of the fillet circles (um). Between touching discs of "
+        "radius R the neck is 2 (sqrt(rho^2 + 2 R rho) - rho): 8 um at rho = 0.5 um (the "
+        "paper's neck, below the grid), 10.8 um at 1 um, 14.3 um at 2 um",
+    )
+    neck_section: Literal["centres", "column"] = Field(
+        "centres",
+        description="centres: each contact's neck is the narrowest section perpendicular to "
+        "the line of its bodies' centres, between the outermost crossings of the interface "
+        "(sub-cell, blind to holes inside the neck); column: the narrowest vertical node column "
+        "between bodies 0 and 1, holes excluded (the measure of the earlier releases)",
     )
 
 

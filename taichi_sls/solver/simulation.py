@@ -16,6 +16,7 @@ from . import checkpoint
 from .blocks import BlockPlan
 from .fields import State
 from .guard import Guard
+from .contacts import neck_width, touching
 from .monitor import body_centroids_x, neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
@@ -107,6 +108,12 @@ class Simulation:
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
         self._pair = len(case.bodies) >= 2
+        # the contacts, found once on the seeded points; each body's reach for the neck
+        # sections is its equivalent radius sqrt(area / pi)
+        sc = self.scene
+        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell)
+        area = np.bincount(sc.body, weights=sc.vol)
+        self._body_radius = np.sqrt(area / np.pi)
         self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
         self._e_static: float | None = None  # the step-independent part of energy_bound
 
@@ -166,18 +173,61 @@ class Simulation:
         return m
 
     def contact_line_m(self, measure: str | None = None) -> tuple[float, float]:
-        """(contact line, neck span) in metres on ``measure`` (default: :meth:`neck_measure`):
-        the narrowest vertical section of material between the two bodies' centroids, on
-        {phi < 0} of eq. 21 or {c > 1/2} of the colour (:mod:`taichi_sls.solver.monitor`)."""
+        """(contact line, neck span) in metres of the first contact (the paper's pair) on
+        ``measure`` (default: :meth:`neck_measure`), sectioned as ``contact.neck_section`` says
+        (:meth:`necks_m`; the column: :mod:`taichi_sls.solver.monitor`)."""
         if not self._pair:
             return float("nan"), float("nan")
+        measure = measure or self.neck_measure()
+        if self.case.contact.neck_section == "centres":
+            if not self.contacts:
+                return 0.0, 0.0
+            w = self.necks_m(measure)[0]
+            return w, w
         x = self.state.points.x.to_numpy()
         cx = body_centroids_x(x, self.scene.body, self._mass)
         lo, hi = sorted(cx[:2])
         cfg = self.state.cfg
-        measure = measure or self.neck_measure()
-        field = 0.5 - self.colour() if measure == "colour" else self.phi()
-        return neck_measures(field, cfg.h, cfg.off, lo, hi)
+        return neck_measures(-self._material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
+
+    def raw_colour(self) -> np.ndarray:
+        """The colour c_i of the current points before any filter: the cell fraction that
+        material fills, from the node mass (or volume, as the case's force takes it)."""
+        self.colour()  # the grid's mass and volume of the current points
+        cfg, nd = self.state.cfg, self.state.nodes
+        if cfg.se.volume_colour:
+            return nd.volume.to_numpy() / cfg.cell_volume
+        return nd.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
+
+    def _material_field(self, measure: str, section: str) -> np.ndarray:
+        """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
+        c - 1/2 of the colour. The sections across the centres read the raw colour: they are
+        blind to the hole that the force's filter is there to close, and the filter's
+        smoothing would widen a concave neck by about kappa h^2. The column reads the colour
+        the force contours."""
+        if measure != "colour":
+            return -self.phi()
+        return (self.raw_colour() if section == "centres" else self.colour()) - 0.5
+
+    def necks_m(self, measure: str | None = None) -> list[float]:
+        """The neck of every contact (m), in the order of ``contacts``: the narrowest section
+        across the line of the two bodies' mass centres, between the outermost crossings of the
+        interface (:func:`taichi_sls.solver.contacts.neck_width`)."""
+        if not self.contacts:
+            return []
+        field = self._material_field(measure or self.neck_measure(), "centres")
+        x = self.state.points.x.to_numpy()
+        body, m = self.scene.body, self._mass
+        n_b = len(self._body_radius)
+        centre = np.stack(
+            [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
+        ) / np.bincount(body, weights=m, minlength=n_b)[:, None]
+        cfg = self.state.cfg
+        out = []
+        for a, b in self.contacts:
+            reach = min(self._body_radius[a], self._body_radius[b])
+            out.append(neck_width(field, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
+        return out
 
     def monitors(self, guard: bool = True) -> dict[str, float]:
         """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard unless
