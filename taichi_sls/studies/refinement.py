@@ -113,7 +113,7 @@ def richardson(
         return Extrapolation(math.nan, math.nan, "not converging: not monotone")
     p = math.log(d_coarse / d_fine) / math.log(ratio)
     if p <= 0:
-        return Extrapolation(p, math.nan, "not converging: the differences grow")
+        return Extrapolation(p, math.nan, "not converging: the differences do not shrink")
     used = min(max(p, p_range[0]), p_range[1])
     note = "" if used == p else f"p clamped to {used:g}"
     return Extrapolation(p, fine + (fine - mid) / (ratio**used - 1), note)
