@@ -365,6 +365,7 @@ def plot(rows: list[dict], path: Path, at: float = 2.0) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     res = [a for a in analyse(rows, at) if a["quantity"] != "T_peak_C"]
     cases = list(dict.fromkeys(r["case"] for r in rows))
@@ -405,8 +406,14 @@ def plot(rows: list[dict], path: Path, at: float = 2.0) -> None:
         bad = [f"{_num(r['h_um']):g}" for r in base if r["status"] not in VALID]
         axs[0, j].set_title(case + (f" (failed: h = {', '.join(bad)})" if bad else ""), fontsize=9)
         axs[1, j].set_title(f"{case}, h = {at:g} um", fontsize=9)
-        for ax, xl in ((axs[0, j], "h [um]"), (axs[1, j], "dt [s]")):
-            ax.set_xscale("log")
+        for ax, xl, xs in (
+            (axs[0, j], "h [um]", [_num(r["h_um"]) for r in base]),
+            (axs[1, j], "dt [s]", [_num(r["dt_s"]) for r in by_dt]),
+        ):
+            ax.set_xscale("log", base=2)
+            if xs:  # ticks at the runs, in plain numbers
+                ax.set_xticks(xs, [f"{x:.3g}" for x in xs])
+                ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_xlabel(xl)
             ax.grid(alpha=0.3, which="both")
             if ax.has_data():

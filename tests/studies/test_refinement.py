@@ -9,6 +9,7 @@ import pytest
 from taichi_sls.studies.refinement import (
     COLUMNS,
     plan,
+    plot,
     read_csv,
     rel_change,
     richardson,
@@ -123,6 +124,8 @@ def test_table_from_a_hand_made_csv(tmp_path):
     assert b[3].strip() == "4 / 2 / 1" and b[4].strip() == "15.5 / 14.5 / failed"
     assert b[5].strip() == "nan" and b[6].strip().startswith("nan (missing value)")
     assert read_csv(tmp_path / "refinement.csv")[-1]["status"] == "failed"
+    plot(read_csv(tmp_path / "refinement.csv"), tmp_path / "refinement.png")
+    assert (tmp_path / "refinement.png").stat().st_size > 0
 
 
 @pytest.mark.slow
