@@ -207,7 +207,7 @@ def run_one(
     from ..jobs.case_run import complete_summary, run_case
 
     stop = "solidified" if refrozen else "end"
-    folder = out / case / f"h{h:g}um_dt{f:g}"
+    folder = out / Path(case).stem / f"h{h:g}um_dt{f:g}"  # a case file: its name, not its path
     own = [f"grid.spacing_um={h}", f"time.dt_s={DT_PER_UM * h * f:.6g}"]
     own += ["time.stop=solidified"] if refrozen else ["time.end_s=1e-3"]
     own += ["output.png=false", "output.gif=false"]  # the frames would cost more than the steps
@@ -431,10 +431,11 @@ DESCRIPTION = (
     "The paper's cases under refinement: each case at each spacing to 1 ms (dt = 2.5e-8 s per "
     "um of h), and at h = --at at every dt factor; writes refinement.csv, refinement_table.md "
     "(observed order, Richardson estimate, dt sensitivity) and refinement.png. Finished runs "
-    "are read, not run again. Run time on two cores, for each case: h = 4 / 2 / 1 / 0.5 um to "
-    "1 ms about 5 s / 20 s / 2.5 min / 20 min, dt/2 and dt/4 at h = 2 um 40 s and 80 s, so "
-    "about 25 min a laser case and 1.5-2 h for the default four; --refrozen (to 20-40 ms) "
-    "about 20-40x the 1 ms run per spacing, 1-2 h a case at h = 1 um."
+    "are read, not run again. Run time (cost ~ points x steps, 0.25-0.5 us per point-step on "
+    "two cores, plus 20-40 s of compilation a run): a case to 1 ms at h = 4 / 2 / 1 / 0.5 um "
+    "(632 / 2.5k / 10k / 40k points, 10k / 20k / 40k / 80k steps) 2-3 s / 15-25 s / 2-3.5 min / "
+    "15-27 min, dt/2 and dt/4 at h = 2 um 0.5-1.5 min, so 20-35 min a case and 1.5-2.5 h for the "
+    "default four; --refrozen (20-40 ms, 20-40x the steps) 2-4 h a laser case."
 )
 
 
@@ -445,7 +446,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=DESCRIPTION,
     )
     ap.add_argument("--out", help="folder for the runs and outputs (default out/refinement)")
-    ap.add_argument("--cases", nargs="+", default=list(CASES), metavar="CASE", help="cases")
+    ap.add_argument(
+        "--cases",
+        nargs="+",
+        default=list(CASES),
+        metavar="CASE",
+        help="bundled cases or case files (default: power5W power15W power25W nolaser)",
+    )
     ap.add_argument(
         "--spacings",
         nargs="+",
