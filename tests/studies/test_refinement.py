@@ -6,15 +6,8 @@ import math
 
 import pytest
 
-from taichi_sls.studies.refinement import (
-    COLUMNS,
-    plan,
-    plot,
-    read_csv,
-    rel_change,
-    richardson,
-    write_table,
-)
+from taichi_sls.studies.refinement import COLUMNS, plan
+from taichi_sls.studies.refinement_report import plot, read_csv, rel_change, richardson, write_table
 
 
 @pytest.mark.parametrize(
