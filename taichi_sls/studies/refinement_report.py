@@ -114,6 +114,9 @@ def analyse(rows: list[dict], at: float = 2.0) -> list[dict]:
                 ext = richardson(*vals, ratio=hs[0] / hs[1])
             else:
                 ext = Extrapolation(math.nan, math.nan, "needs three spacings in one ratio")
+            bad = [f"{h:g}" for h in hs if base[h]["status"] not in VALID]
+            if bad:  # say why a value is missing
+                ext = Extrapolation(ext.order, ext.estimate, f"h = {', '.join(bad)} um failed")
             f_at = value(base[at]) if at in base else math.nan
             dts = [value(r) for r in by_dt]
             out.append(

@@ -115,7 +115,7 @@ def test_table_from_a_hand_made_csv(tmp_path):
     assert ("A", "neck refrozen (um)") not in lines  # no run refroze: no row
     b = lines[("B", "neck refrozen (um)")].split("|")
     assert b[3].strip() == "4 / 2 / 1" and b[4].strip() == "15.5 / 14.5 / failed"
-    assert b[5].strip() == "nan" and b[6].strip().startswith("nan (missing value)")
+    assert b[5].strip() == "nan" and b[6].strip() == "nan (h = 1 um failed)"
     assert read_csv(tmp_path / "refinement.csv")[-1]["status"] == "failed"
     plot(read_csv(tmp_path / "refinement.csv"), tmp_path / "refinement.png")
     assert (tmp_path / "refinement.png").stat().st_size > 0
