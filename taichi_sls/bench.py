@@ -1,5 +1,5 @@
 """``python -m taichi_sls.bench STUDY ...``: the benchmarks and studies (``taichi-sls bench``:
-speed, cost, accuracy, paper, neck; see :mod:`taichi_sls.cli`)."""
+speed, cost, accuracy, paper, neck, refinement; see :mod:`taichi_sls.cli`)."""
 
 import sys
 

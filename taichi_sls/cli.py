@@ -2,7 +2,8 @@
 
     run CASE         run a case file (or a bundled case by name) with every output
     sweep SWEEP      a parameter sweep on Dask
-    bench STUDY      speed, accuracy, paper (the Table 2 cases), neck (the melted-pair study)
+    bench STUDY      speed, accuracy, paper (the Table 2 cases), neck (the melted-pair study),
+                     refinement (the paper's cases under grid and dt refinement)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -127,7 +128,7 @@ def case_command(args: argparse.Namespace) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    from .studies import accuracy, cost_error, neck_study, paper, robustness, speed
+    from .studies import accuracy, cost_error, neck_study, paper, refinement, robustness, speed
     from .studies.sweep import runner as sweep
 
     ap = argparse.ArgumentParser(
@@ -139,10 +140,10 @@ def parser() -> argparse.ArgumentParser:
     p.set_defaults(func=run_command)
     sweep.add_parser(sub)
     bench = sub.add_parser(
-        "bench", help="benchmarks and studies: speed, cost, accuracy, paper, neck"
+        "bench", help="benchmarks and studies: speed, cost, accuracy, paper, neck, refinement"
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
-    for module in (speed, cost_error, accuracy, paper, neck_study):
+    for module in (speed, cost_error, accuracy, paper, neck_study, refinement):
         module.add_parser(studies)
     robustness.add_parser(sub)
     p = sub.add_parser("case", help="print the case-file reference (every key, default, unit)")

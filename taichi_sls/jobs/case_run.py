@@ -207,12 +207,15 @@ def run_case(
     return summary
 
 
-def complete_summary(out_dir: Path) -> dict[str, Any] | None:
+def complete_summary(
+    out_dir: Path, statuses: tuple[str, ...] = ("complete",)
+) -> dict[str, Any] | None:
     """The summary of a run already complete in out_dir, else None: the studies run again only
-    what is missing (delete the folder to rerun)."""
+    what is missing (delete the folder to rerun). ``statuses``: the ends that count as done (a
+    study may keep a run the guard stopped: on the CPU it would fail the same way again)."""
     path = Path(out_dir) / "summary.json"
     summary = json.loads(path.read_text()) if path.is_file() else None
-    return summary if summary is not None and summary.get("status") == "complete" else None
+    return summary if summary is not None and summary.get("status") in statuses else None
 
 
 def print_outcome(summary: dict[str, Any]) -> None:
