@@ -97,6 +97,137 @@ def perzyna_history(mat: Material, strains: np.ndarray, dt: float) -> tuple[np.n
     return r[:, 0], r[:, 1]
 
 
+def elastic_state(mat: Material, e0: np.ndarray, xi: float) -> tuple[np.ndarray, np.ndarray]:
+    """(Fe, sigma) of a point at rest (J = 1) carrying the symmetric 3x3 elastic strain e0 at
+    solid fraction xi: the stretch exp(e0) of the finite form and Hooke's stress, which is its
+    Hencky stress too."""
+    E = xi * mat.youngs_solid_Pa + (1 - xi) * mat.youngs_liquid_Pa
+    nu = xi * mat.poisson + (1 - xi) * mat.poisson_liquid
+    mu, K = E / (2 * (1 + nu)), E / (3 * (1 - 2 * nu))
+    w, Q = np.linalg.eigh(e0)
+    tr = np.trace(e0)
+    sig = K * tr * np.eye(3) + 2 * mu * (e0 - tr / 3 * np.eye(3))
+    return Q @ np.diag(np.exp(w)) @ Q.T, sig
+
+
+def constitutive_history(
+    mat: Material,
+    incs: np.ndarray,
+    dt: float,
+    *,
+    strain: str = "finite",
+    e0: np.ndarray | None = None,
+    xi: np.ndarray | None = None,
+    plastic: bool = True,
+    T_K: float = 300.0,
+) -> np.ndarray:
+    """Drive one point of the solver's stress update through prescribed relative deformation
+    gradients ``incs`` (n, 3, 3; f = I + dt L, f_zz = 1 in plane strain) from the elastic
+    strain e0 at rest (F = I). ``strain``: "finite" (constitutive.hencky_update) or "small" (the
+    incremental form, constitutive.perzyna_increment, with d eps = sym(f) - I); ``xi``: the
+    solid fraction of every step (default solid). Returns the Cauchy stress after every step
+    (n, 3, 3)."""
+    from ...physics.materials import material_struct
+    from ...solver.params import material_values
+    from ...solver.simulation import init_taichi
+
+    init_taichi(optimize=False)
+    n = len(incs)
+    xs = np.ones(n) if xi is None else np.asarray(xi, dtype=float)
+    Fe0, sig0 = elastic_state(mat, np.zeros((3, 3)) if e0 is None else e0, float(xs[0]))
+    mf = material_struct().field(shape=1)
+    mf.from_numpy({k: np.array([v]) for k, v in material_values(mat, 0.0).items()})
+    out = np.zeros((n, 3, 3))
+    _drive(
+        mf,
+        np.ascontiguousarray(incs, dtype=float),
+        np.ascontiguousarray(xs),
+        np.stack([Fe0, sig0]),
+        out,
+        dt,
+        T_K,
+        strain == "finite",
+        plastic,
+    )
+    return out
+
+
+def _drive_kernel():
+    """The point driver of :func:`constitutive_history`, built once (ndarray arguments: one
+    compile, which Taichi's offline cache keeps across re-initialisations)."""
+    import taichi as ti
+
+    from ...physics.constitutive import SQRT23, hencky_update, perzyna_increment
+
+    @ti.func
+    def mat3(a: ti.template(), k):
+        m = ti.Matrix.zero(float, 3, 3)
+        for i, j in ti.static(ti.ndrange(3, 3)):
+            m[i, j] = a[k, i, j]
+        return m
+
+    @ti.kernel
+    def drive(
+        mf: ti.template(),
+        f_in: ti.types.ndarray(),
+        x_in: ti.types.ndarray(),
+        start: ti.types.ndarray(),
+        out: ti.types.ndarray(),
+        dt: float,
+        T_K: float,
+        finite: ti.template(),
+        plastic: ti.template(),
+    ):
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            I3 = ti.Matrix.identity(float, 3)
+            Fe, sig, F = mat3(start, 0), mat3(start, 1), I3
+            alpha, xl = 0.0, x_in[0]
+            for k in range(f_in.shape[0]):
+                f = mat3(f_in, k)
+                F = f @ F
+                dgam = 0.0
+                if ti.static(finite):
+                    sig, Fe, dgam, _n = hencky_update(
+                        mf[0], Fe, xl, alpha, f, 0.0, x_in[k], T_K, F.determinant(), dt,
+                        plastic, 2,
+                    )  # fmt: skip
+                    xl = x_in[k]
+                else:
+                    deps = 0.5 * (f + f.transpose()) - I3
+                    sig, dgam, _n = perzyna_increment(
+                        mf[0], sig, deps, 0.0, alpha, x_in[k], T_K, dt, plastic
+                    )
+                alpha += SQRT23 * dgam
+                for i, j in ti.static(ti.ndrange(3, 3)):
+                    out[k, i, j] = sig[i, j]
+
+    return drive
+
+
+def _drive(*args) -> None:
+    global _DRIVE
+    if _DRIVE is None:
+        _DRIVE = _drive_kernel()
+    _DRIVE(*args)
+
+
+_DRIVE = None
+
+
+def rotation_increment(dtheta: float) -> np.ndarray:
+    """The exact in-plane rotation by dtheta as a relative deformation gradient (3x3)."""
+    c, s = math.cos(dtheta), math.sin(dtheta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def shear_increment(rate: float, dt: float) -> np.ndarray:
+    """f = I + dt L of simple shear v_x = rate y."""
+    f = np.eye(3)
+    f[0, 1] = rate * dt
+    return f
+
+
 def run_perzyna(vc: VerificationCase) -> Result:
     """Perzyna return map at one point (eqs. 40-45), time step dt = case.time.dt_s:
 
