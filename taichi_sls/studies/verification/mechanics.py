@@ -1,5 +1,5 @@
 """Verification of the mechanics: the vibrating bar, the manufactured solution, the Perzyna
-return map at one point."""
+return map at one point, the finite-strain update at one point."""
 
 import math
 import time
@@ -280,4 +280,75 @@ def run_perzyna(vc: VerificationCase) -> Result:
         transfer=transfer_label(case),  # no grid transfer: the label keeps the rows together
         precision=case.solver.precision,
         info={"tau_s": eta / (2 * mu), "overstress_at_hold": float(f[n_load - 1])},
+    )
+
+
+def run_finite_strain(vc: VerificationCase) -> Result:
+    """The finite-strain update (solver.strain = "finite", constitutive.hencky_update) at one
+    point of a Maxwell material (zero yield; viscosity_model = "constant"), dt = case.time.dt_s,
+    n = end_s / dt steps:
+
+    - ``maxwell_relaxation``: a point prestressed in shear (hold_strain) held at rest, max
+      deviator error against s0 exp(-t / tau) (references.maxwell_relaxation) / s0;
+    - ``maxwell_shear``: simple shear at shear_rate_1_s from rest, max shear stress error
+      against mu rate tau (1 - exp(-t / tau)) (references.maxwell_shear_stress) / its steady
+      value (first order in dt, plus the finite-strain terms of order (rate tau)^2);
+    - ``quarter_turn``: the prestressed point (elastic) turned by a quarter turn in n exact
+      rotation increments, max |sigma - R sigma0 R^T| / |sigma0| (round-off);
+    - ``full_turn_invariants``: a full turn in n increments, max relative drift of pressure
+      and von Mises stress (round-off).
+    """
+    case = vc.case
+    t0 = time.perf_counter()
+    mat = material(case)
+    v = vc.spec
+    if mat.viscosity_model != "constant":
+        raise CaseError("verification.kind = 'finite_strain': needs viscosity_model = 'constant'")
+    mu = mat.youngs_solid_Pa / (2 * (1 + mat.poisson))
+    tau = mat.viscosity_Pas / (2 * mu)
+    dt = float(case.time.dt_s)
+    n = int(round(case.time.end_s / dt))
+    t = dt * np.arange(1, n + 1)
+    e0 = np.zeros((3, 3))
+    e0[0, 1] = e0[1, 0] = v.hold_strain
+    sig0 = elastic_state(mat, e0, 1.0)[1]
+    rest = constitutive_history(mat, np.tile(np.eye(3), (n, 1, 1)), dt, e0=e0)
+    relax = np.abs(rest[:, 0, 1] - ref.maxwell_relaxation(t, sig0[0, 1], tau)).max()
+    shear = constitutive_history(mat, np.tile(shear_increment(v.shear_rate_1_s, dt), (n, 1, 1)), dt)
+    steady = mu * v.shear_rate_1_s * tau
+    shear_err = np.abs(shear[:, 0, 1] - ref.maxwell_shear_stress(t, v.shear_rate_1_s, mu, tau))
+    quarter = rotation_increment(0.5 * math.pi)
+    q = constitutive_history(
+        mat, np.tile(rotation_increment(0.5 * math.pi / n), (n, 1, 1)), dt, e0=e0, plastic=False
+    )[-1]
+    full = constitutive_history(
+        mat, np.tile(rotation_increment(2 * math.pi / n), (n, 1, 1)), dt, e0=e0, plastic=False
+    )
+
+    def drift(x: np.ndarray, x0: float) -> float:
+        return float(np.abs(x / x0 - 1.0).max()) if x0 != 0.0 else float(np.abs(x).max())
+
+    p = np.trace(full, axis1=1, axis2=2) / 3
+    dev = full - p[:, None, None] * np.eye(3)
+    dev0 = sig0 - np.trace(sig0) / 3 * np.eye(3)
+    mises = np.sqrt(1.5 * (dev * dev).sum(axis=(1, 2)))
+    scale = float(np.abs(sig0).max())
+    errors = {
+        "maxwell_relaxation": float(relax / abs(sig0[0, 1])),
+        "maxwell_shear": float(shear_err.max()) / steady,
+        "quarter_turn": float(np.abs(q - quarter @ sig0 @ quarter.T).max()) / scale,
+        "full_turn_invariants": max(
+            float(np.abs(p - np.trace(sig0) / 3).max()) / scale,
+            drift(mises, float(np.sqrt(1.5 * (dev0 * dev0).sum()))),
+        ),
+    }
+    return Result(
+        case=case.case.name,
+        h_um=case.grid.spacing_um,
+        dt_s=dt,
+        errors=errors,
+        wall_s=time.perf_counter() - t0,
+        steps=4 * n,
+        transfer=transfer_label(case),  # no grid transfer: the label keeps the rows together
+        precision=case.solver.precision,
     )
