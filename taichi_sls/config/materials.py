@@ -58,3 +58,15 @@ class Material(Model):
     viscosity_b_1_C: float = Field(0.02, ge=0, description="b of the exponential law (1/C)")
     viscosity_Pas: float = Field(1e3, gt=0, description="constant viscosity (Pa s)")
     surface_tension_N_m: float = Field(36.3e-3, ge=0, description="gamma (N/m)")
+    solvent_viscosity_Pa_s: float = Field(
+        0.0,
+        ge=0,
+        description="eta_s of a Kelvin-Voigt 'solvent' viscosity of the melt, a physical "
+        "damping beside the paper's model (0: off, the paper's): the stress 2 eta_s dev(D), D = "
+        "sym(L), weighted by the molten share (1 - xi_s), is added to the internal force only "
+        "(it never enters the stored elastic state). It damps the melt's elastic ringing; size "
+        "it to eta_s ~ rho c_s R, c_s = sqrt(mu_melt / rho) the melt's shear wave speed and R "
+        "the particle radius (the critical damping of the particle's lowest modes): some "
+        "0.01 Pa s for the paper's PA12, five orders below the melt viscosity. Its explicit "
+        "limit dt <= rho h^2 / (c eta_s) joins the automatic time step (solver/params.py)",
+    )

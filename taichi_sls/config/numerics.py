@@ -149,6 +149,13 @@ class Solver(Model):
         description="let the compiler reorder floating-point arithmetic (Taichi's fast_math); "
         "false: strict IEEE order, bitwise reproducible across changes of code structure",
     )
-    strain: Literal["small"] = Field(
-        "small", description="small: accumulated eps += sym(L) dt (eqs. 16-17; not objective)"
+    strain: Literal["small", "finite"] = Field(
+        "small",
+        description="small: accumulated eps += sym(L) dt (eqs. 16-17; not objective), with "
+        "stress_form and stress_reading; finite: multiplicative split F = Fe Fp, Hencky "
+        "(logarithmic) elastic strain and the same Perzyna return map (eqs. 40-45) on the "
+        "principal Kirchhoff stress, thermal and solidification strains removed from the "
+        "elastic stretch (objective: a rigid rotation rotates the stress; needs stress_reading "
+        '= "model"; stress_form does not apply: the stress stays continuous through melting and '
+        "freezing as in the incremental form)",
     )

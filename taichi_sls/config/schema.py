@@ -113,6 +113,12 @@ class Case(Model):
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+        if self.solver.stress_reading == "paper" and self.solver.strain == "finite":
+            raise CaseError(
+                'solver.stress_reading = "paper" with solver.strain = "finite": the printed '
+                'eq. 39 is a small-strain law; use stress_reading = "model" (allowed with '
+                'finite strain) or strain = "small" (allowed: "small", "finite")'
+            )
         if self.solver.stress_reading == "paper" and self.solver.stress_form != "total":
             raise CaseError(
                 f"solver.stress_form = {self.solver.stress_form!r}: the printed eq. 39 "

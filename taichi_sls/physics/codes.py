@@ -59,3 +59,10 @@ class StressForm(IntEnum):
 
     TOTAL = 0  # stress from the accumulated elastic strain at the current moduli (eqs. 38-39)
     INCREMENTAL = 1  # the last stress plus the current moduli times the strain increment
+
+
+class Strain(IntEnum):
+    """``solver.strain``."""
+
+    SMALL = 0  # accumulated eps += sym(L) dt (eqs. 16-17), total or incremental stress form
+    FINITE = 1  # F = Fe Fp, Hencky elastic strain, the Perzyna map on the Kirchhoff stress

@@ -4,16 +4,33 @@ Plane strain: the in-plane total strain is accumulated from the velocity gradien
 (eqs. 16-17, eps_zz = 0); plastic, thermal and transformation strains are full 3x3 tensors.
 Readings of MODEL.md: s_trial = 2 mu dev(eps_e) (eq. 39 lost its 2 mu on the trace term) and
 p = K tr(eps_e), K = lambda + 2 mu / 3, with eps_e = eps - eps_pl - (eps_th + eps_m).
+
+Finite strain (``solver.strain = "finite"``, :func:`hencky_update`): F = Fe Fp; the elastic
+left Cauchy-Green tensor b_e = Fe Fe^T gives the principal stretches and directions, the Hencky
+strain e_i = log(lambda_i), the Kirchhoff stress tau_i = 2 mu dev(e)_i + K tr(e) and the same
+Perzyna map (eqs. 40-45) on its deviator, backward Euler (zero yield: a Maxwell fluid).
 """
 
 import math
 
 import taichi as ti
 
-from .codes import StressForm, StressReading
+from .codes import Strain, StressForm, StressReading
 from .materials import lerp_phase, viscosity
 
 SQRT23 = math.sqrt(2.0 / 3.0)
+# the smallest principal elastic stretch whose logarithm is taken: a point compressed past it
+# (or inverted, which its J <= 0 shows to the guard, solver/step.py watch) keeps a finite strain
+STRETCH_FLOOR = 1e-6
+
+
+@ti.func
+def to3(A, dim: ti.template()):
+    """A dim x dim tensor as 3x3 (plane strain: zero out-of-plane row and column)."""
+    out = ti.Matrix.zero(float, 3, 3)
+    for a, b in ti.static(ti.ndrange(dim, dim)):
+        out[a, b] = A[a, b]
+    return out
 
 
 @ti.func
@@ -118,7 +135,141 @@ def perzyna_increment(
 
 
 @ti.func
+def bulk_shear(mp: ti.template(), xi):
+    """(mu, K) of material ``mp`` at solid fraction xi."""
+    E, nu = moduli(mp, xi)
+    return E / (2.0 * (1.0 + nu)), E / (3.0 * (1.0 - 2.0 * nu))
+
+
+@ti.func
+def principal_frame(b, dim: ti.template()):
+    """Eigenvalues (a 3-vector) and eigenvectors (columns of a rotation Q) of the symmetric 3x3
+    b. Plane strain (dim 2): the in-plane 2x2 block in closed form, angle from atan2 (exact for
+    near-equal eigenvalues; ti.svd's 2x2 treats an off-diagonal below 1e-5 as zero, which erased
+    small elastic shears step after step) and b_zz as the third; dim 3: ti.sym_eig."""
+    Q = ti.Matrix.identity(float, 3)
+    ev = ti.Vector([b[0, 0], b[1, 1], b[2, 2]])
+    if ti.static(dim == 2):
+        half = 0.5 * (b[0, 0] - b[1, 1])
+        r = ti.sqrt(half * half + b[0, 1] * b[0, 1])
+        mean = 0.5 * (b[0, 0] + b[1, 1])
+        th = 0.5 * ti.atan2(b[0, 1], half)
+        c, s = ti.cos(th), ti.sin(th)
+        Q[0, 0], Q[0, 1], Q[1, 0], Q[1, 1] = c, -s, s, c
+        ev[0], ev[1] = mean + r, mean - r
+    else:
+        ev, Q = ti.sym_eig(b)
+    return ev, Q
+
+
+@ti.func
+def hencky_update(
+    mp: ti.template(),
+    Fe,
+    xi_last,
+    alpha,
+    f,
+    d_iso,
+    xi,
+    T,
+    J,
+    dt,
+    plastic: ti.template(),
+    dim: ti.template(),
+):
+    """One finite-strain step of material ``mp``: Fe the 3x3 elastic stretch before the step,
+    f = I + dt L its relative deformation gradient (3x3, f_zz = 1 in plane strain), J = det F.
+    Returns (sigma, Fe, dgamma, n): the Cauchy stress, the new elastic stretch (the symmetric
+    left stretch V_e: the stress of an isotropic material depends on b_e = Fe Fe^T only) and the
+    plastic multiplier and direction (global frame; dgamma = 0: elastic).
+
+    Trial b_e = f b_e,n f^T (objective: a rotation increment rotates b_e, its eigenvalues stay);
+    Hencky strain e_i = log(lambda_i) less the step's isotropic thermal and solidification strain
+    d_iso (eqs. 36-37) from each principal value, the out-of-plane one too. A change of the solid
+    fraction since the stored strain was last turned into stress (xi_last != xi, melting or
+    freezing: the moduli change tenfold) rescales the deviatoric strain by mu_old/mu and the
+    volumetric by K_old/K: the stress stays continuous and the difference becomes permanent
+    deformation, as in the incremental small-strain form (a melt freezes in the shape it has
+    instead of springing back). It applies to the trial strain, this step's increment included:
+    a difference of order d(xi) dt. Then s_tr = 2 mu dev(e), the Perzyna correction of eqs.
+    40-45 on the Kirchhoff deviator, tau = s + K tr(e) 1 and sigma = Q tau Q^T / J."""
+    mu, K = bulk_shear(mp, xi)
+    b = f @ Fe @ Fe.transpose() @ f.transpose()
+    ev, Q = principal_frame(b, dim)
+    e = ti.Vector.zero(float, 3)
+    for i in ti.static(range(3)):
+        e[i] = 0.5 * ti.log(ti.max(ev[i], STRETCH_FLOOR * STRETCH_FLOOR)) - d_iso
+    e_vol = e.sum()
+    e_dev = e - e_vol / 3.0
+    if xi_last != xi:
+        mu0, K0 = bulk_shear(mp, xi_last)
+        e_dev *= mu0 / mu
+        e_vol *= K0 / K
+    s = ti.Matrix.zero(float, 3, 3)
+    for i in ti.static(range(3)):
+        s[i, i] = 2.0 * mu * e_dev[i]
+    dgam = 0.0
+    n = ti.Matrix.zero(float, 3, 3)
+    if ti.static(plastic):
+        s, dgam, n = perzyna_return(mp, s, alpha, mu, xi, T, dt)
+    tau = ti.Matrix.zero(float, 3, 3)
+    lam = ti.Matrix.zero(float, 3, 3)
+    for i in ti.static(range(3)):
+        tau[i, i] = s[i, i] + K * e_vol
+        lam[i, i] = ti.exp(s[i, i] / (2.0 * mu) + e_vol / 3.0)
+    Qt = Q.transpose()
+    return Q @ tau @ Qt / J, Q @ lam @ Qt, dgam, Q @ n @ Qt
+
+
+@ti.func
+def solvent_stress(mp: ti.template(), L, xi):
+    """The Kelvin-Voigt solvent stress of the melt, (1 - xi_s) 2 eta_s dev(D), D = sym(L), in
+    plane (``materials.*.solvent_viscosity_Pa_s``): a force term only, outside the elastic
+    state, so it damps without entering the stress history."""
+    D = 0.5 * (L + L.transpose())
+    dev = D - D.trace() / 3.0 * ti.Matrix.identity(float, L.n)
+    return 2.0 * mp.solvent_viscosity_Pa_s * (1.0 - xi) * dev
+
+
+@ti.func
 def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
+    """The stress of point p after a step of velocity gradient L: ``solver.strain`` finite
+    (:func:`hencky_update`) or small (:func:`small_strain_update`); with a solvent viscosity
+    also its stress (force only)."""
+    if ti.static(cfg.strain == Strain.FINITE):
+        d_iso = 0.0
+        if ti.static(cfg.th_strain):
+            d_iso = pt.iso_strain_step[p]
+        I3 = ti.Matrix.identity(float, 3)  # f_zz = 1: plane strain
+        sig, Fe, dgam, n = hencky_update(
+            mat[pt.material[p]],
+            pt.elastic_stretch[p],
+            pt.stress_phase[p],
+            pt.equivalent_plastic_strain[p],
+            I3 + dt * to3(L, cfg.dim),
+            d_iso,
+            pt.solid_fraction[p],
+            pt.T[p],
+            pt.J[p],
+            dt,
+            cfg.plastic,
+            cfg.dim,
+        )
+        pt.stress[p] = sig
+        pt.elastic_stretch[p] = Fe
+        pt.stress_phase[p] = pt.solid_fraction[p]
+        if ti.static(cfg.plastic):
+            if dgam > 0.0:
+                pt.plastic_strain[p] += dgam * n
+                pt.equivalent_plastic_strain[p] += SQRT23 * dgam
+    else:
+        small_strain_update(cfg, pt, mat, p, L, dt)
+    if ti.static(cfg.solvent):
+        pt.viscous_stress[p] = solvent_stress(mat[pt.material[p]], L, pt.solid_fraction[p])
+
+
+@ti.func
+def small_strain_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
     """Strain increment (eqs. 16-17, 34) and the Perzyna update (eqs. 38-45) of point p, in the
     total form (stress from the accumulated elastic strain, the paper's) or the incremental one
     (``solver.stress_form``; it needs neither the accumulated strain nor the plastic strain,

@@ -43,6 +43,7 @@ MATERIAL_MEMBERS = (
     "viscosity_b_1_C",
     "viscosity_Pas",
     "surface_tension_N_m",
+    "solvent_viscosity_Pa_s",
     "enthalpy_reference_K",
     "enthalpy_crystallization_J_kg",  # H(T_c)
     "enthalpy_melt_J_kg",  # H(T_m)

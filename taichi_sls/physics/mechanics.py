@@ -55,6 +55,8 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
     sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
     for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
         sig[a, b] = pt.stress[p][a, b]
+    if ti.static(cfg.solvent):
+        sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
     g = ti.Vector(cfg.gravity, dt=float)
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)

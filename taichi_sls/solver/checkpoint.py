@@ -23,12 +23,17 @@ POINT_MEMBERS = (
     "iso_strain",
     "iso_strain_step",
     "stress",
+    "elastic_stretch",
+    "stress_phase",
+    "viscous_stress",
     "J",
     "enthalpy",
     "T",
     "solid_fraction",
     "time_molten",
 )
+# added after checkpoints were first written: an older one resumes with their initial values
+LATER_MEMBERS = ("elastic_stretch", "stress_phase", "viscous_stress")
 SCALARS = ("t", "dt", "laser_energy", "heat_out", "T_peak")
 # the curvature is kept between rebuilds (surface_tension.curvature_every): part of the state
 NODE_MEMBERS = ("kappa", "flags")
@@ -62,7 +67,8 @@ def load(st: State, path: Path, case_name: str) -> tuple[int, dict]:
             f"does not match case {case_name!r} with {st.n_points} points"
         )
     for k in POINT_MEMBERS:
-        getattr(st.points, k).from_numpy(z[f"p_{k}"])
+        if f"p_{k}" in z.files or k not in LATER_MEMBERS:
+            getattr(st.points, k).from_numpy(z[f"p_{k}"])
     for k in SCALARS:
         getattr(st.scalars, k)[None] = float(z[f"s_{k}"])
     for k in NODE_MEMBERS:

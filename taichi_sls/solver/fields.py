@@ -6,8 +6,11 @@ Points (``points``, one element per material point; SI):
   gradient; J its determinant; strain the accumulated small strain (eqs. 16-17); plastic_strain
   (3x3, plane strain); equivalent_plastic_strain (eq. 43); iso_strain the isotropic thermal and
   transformation strain (eqs. 36-37) and iso_strain_step its increment per mechanical step;
-  stress (3x3); volume0; mass; material (index); enthalpy (J/kg); T (K); solid_fraction (eq. 33);
-  time_molten (s above T_m, the fusion verdict's input).
+  stress (3x3, Cauchy); elastic_stretch the 3x3 elastic left stretch V_e of solver.strain =
+  "finite" (identity at rest) and stress_phase the solid fraction at which its strain was last
+  turned into stress (physics/constitutive.py, hencky_update); viscous_stress the melt's solvent
+  stress (force only); volume0; mass; material (index); enthalpy (J/kg); T (K); solid_fraction
+  (eq. 33); time_molten (s above T_m, the fusion verdict's input).
 Nodes (``nodes``, the grid of ``nx x ny``):
   mass, momentum, force; v_old = v^n and v = v^{n+1}; heat_capacity (eq. 28), capacity_T
   (sum c T), T, heat_rate (eqs. 29-30), dT, deviation and deviation_capacity (the sub-grid
@@ -65,6 +68,9 @@ POINT_MEMBERS = {
     "iso_strain": "scalar",
     "iso_strain_step": "scalar",
     "stress": "matrix3",
+    "elastic_stretch": "matrix3",
+    "stress_phase": "scalar",
+    "viscous_stress": "matrix",
     "volume0": "scalar",
     "J": "scalar",
     "mass": "scalar",
@@ -206,17 +212,21 @@ class State:
             pt.strain[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
             pt.plastic_strain[p] = ti.Matrix.zero(float, 3, 3)
             pt.stress[p] = ti.Matrix.zero(float, 3, 3)
+            pt.elastic_stretch[p] = ti.Matrix.identity(float, 3)
+            pt.viscous_stress[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
             pt.equivalent_plastic_strain[p] = 0.0
             pt.iso_strain[p] = 0.0
             pt.iso_strain_step[p] = 0.0
             pt.enthalpy[p] = enthalpy(self.materials[pt.material[p]], pt.T[p])
             pt.solid_fraction[p] = solid_fraction(self.materials[pt.material[p]], pt.T[p])
+            pt.stress_phase[p] = pt.solid_fraction[p]
 
     @ti.kernel
     def _prestress(self, p0: ti.types.ndarray()):
         """The elastic strain that carries an in-plane pressure p0 (plane strain, eps_zz = 0:
         eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at each point's initial moduli, and its stress
-        under the case's stress reading."""
+        under the case's stress reading; finite strain: the elastic stretch Fe = exp(eps) of the
+        same strain, whose Hencky stress at J = 1 is the same."""
         pt = ti.static(self.points)
         for p in range(self.cfg.n_points):
             if p0[p] != 0.0:
@@ -226,6 +236,8 @@ class State:
                 lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
                 eps = ti.Matrix.identity(float, self.cfg.dim) * (-p0[p] / (2.0 * lam_mu))
                 pt.strain[p] = eps
+                for a in ti.static(range(self.cfg.dim)):
+                    pt.elastic_stretch[p][a, a] = ti.exp(eps[a, a])
                 z = ti.Matrix.zero(float, 3, 3)
                 pt.stress[p] = perzyna_update(
                     mp, embed3(eps), z, 0.0, 0.0, xi, pt.T[p], 1.0, False, self.cfg.stress_reading

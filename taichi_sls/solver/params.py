@@ -81,6 +81,15 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
 
 # ----------------------------------------------------------------------------- stability
 
+# c of the solvent viscosity's explicit limit dt <= rho h^2 / (c eta_s) in two dimensions. The
+# stress 2 eta_s dev(D) (3D deviator, plane strain) gives the momentum equation
+# eta_s (lap v + grad div v / 3); on a lumped-mass grid of spacing h the discrete Laplacian's
+# largest eigenvalue is 4 d / h^2 (d = 2; the uGIMP weights only smooth it) and the grad-div
+# part adds at most a third, so nu lambda_max <= (4/3) 4 d nu / h^2, nu = eta_s / rho; forward
+# Euler in the velocity is stable for dt lambda_max <= 2: c = 8 d / 3. It is taken beside the
+# elastic limit, not combined with it: time.safety (0.4) covers the two acting together.
+VISCOUS_STENCIL = 8.0 * 2 / 3.0
+
 
 def p_wave_modulus(E: float, nu: float) -> float:
     """M = E (1 - nu) / ((1 + nu)(1 - 2 nu)): the modulus of the fastest (dilatational) wave."""
@@ -91,7 +100,8 @@ def stability_limits(m: Material, h: float) -> dict[str, float]:
     """Time-step limits (s) of one material on grid spacing h (m), MODEL.md / eqs. 46-48.
 
     The elastic limit uses the larger P-wave modulus of the two phases, each with its own nu;
-    the thermal limit the smallest heat capacity and largest conductivity.
+    the thermal limit the smallest heat capacity and largest conductivity; a solvent
+    viscosity adds its own ("viscous", :data:`VISCOUS_STENCIL`).
     """
     M = max(
         p_wave_modulus(m.youngs_solid_Pa, m.poisson),
@@ -101,6 +111,8 @@ def stability_limits(m: Material, h: float) -> dict[str, float]:
     k = max(m.conductivity_solid_W_mK, m.conductivity_liquid_W_mK)
     c = min(m.heat_capacity_solid_J_kgK, m.heat_capacity_liquid_J_kgK)
     out = {"elastic": h / c_wave, "thermal": h * h * m.density_kg_m3 * c / (4 * k)}
+    if m.solvent_viscosity_Pa_s > 0:
+        out["viscous"] = h * h * m.density_kg_m3 / (VISCOUS_STENCIL * m.solvent_viscosity_Pa_s)
     if m.surface_tension_N_m > 0:
         out["surface_tension"] = math.sqrt(m.density_kg_m3 * h**3 / m.surface_tension_N_m)
     return out

@@ -12,6 +12,7 @@ from enum import IntEnum
 
 from ..config import Case
 from ..physics.codes import (
+    Strain,
     StressForm,
     StressReading,
     SurfaceMethod,
@@ -74,6 +75,8 @@ class StepConfig:
     has_gravity: bool
     stress_reading: StressReading
     stress_form: StressForm
+    strain: Strain  # small (stress_form, stress_reading) or finite (physics/constitutive.py)
+    solvent: bool  # some material has a Kelvin-Voigt solvent viscosity (force term)
     # ---- transfers and layout
     transfer: Transfer
     flip_ratio: float
@@ -183,6 +186,9 @@ def step_config(
         has_gravity=any(g != 0.0 for g in ph.gravity_m_s2),
         stress_reading=StressReading.PAPER if sv.stress_reading == "paper" else StressReading.MODEL,
         stress_form=StressForm[sv.stress_form.upper()],
+        strain=Strain[sv.strain.upper()],
+        solvent=ph.mechanics
+        and any(m.solvent_viscosity_Pa_s > 0.0 for m in case.materials.values()),
         transfer=Transfer[sv.transfer.upper()],
         flip_ratio=flip_share(case, dt),
         update=Update[sv.update.upper()],

@@ -16,15 +16,18 @@ def time_step_limits(case: Case) -> dict[str, float]:
         "elastic": ph.mechanics,
         "thermal": ph.thermal,
         "surface_tension": ph.surface_tension and ph.mechanics,
+        "viscous": ph.mechanics,
     }
-    # inertia scaling lengthens the limits set by inertia (waves and capillary oscillation)
-    inertial = {"elastic": True, "surface_tension": True, "thermal": False}
-    s = math.sqrt(case.solver.mass_scale)
+    # inertia scaling lengthens the limits set by inertia: waves and capillary oscillation by
+    # sqrt(s), the viscous diffusion of momentum (rho h^2 / c eta) by s
+    s = case.solver.mass_scale
+    scale = {"elastic": math.sqrt(s), "surface_tension": math.sqrt(s), "thermal": 1.0}
+    scale["viscous"] = s
     out: dict[str, float] = {}
     for m in case.materials.values():
         for k, v in stability_limits(m, h).items():
             if keep.get(k, False):
-                out[k] = min(out.get(k, math.inf), v * s if inertial[k] else v)
+                out[k] = min(out.get(k, math.inf), v * scale[k])
     return out
 
 

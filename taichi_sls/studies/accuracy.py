@@ -77,6 +77,7 @@ STUDIES = (
     Study("bar_large", (8, 16, 32), (16,), "com_velocity"),
     Study("steffen", (8, 16, 32), (8, 16), "displacement_rms", transfers_at=(32,)),
     Study("perzyna", (200, 400, 800), (200, 400), "rate_vs_closed_form"),
+    Study("finite_strain", (500, 1000, 2000), (500,), "maxwell_shear"),
     Study("erf", (4.0, 2.0, 1.0), (4.0, 2.0), "temperature_rms", f32_at=(2.0,)),
     Study("gaussian", (4.0, 2.0, 1.0), (4.0, 2.0), "temperature_rms", f32_at=(2.0,)),
     Study("stefan", (25, 50, 100), (25,), "melt_front"),

@@ -9,6 +9,9 @@ from pathlib import Path
 from . import verification as ver
 from .verification.common import transfer_label
 
+# point-level cases: their resolution is the time step, not the grid
+POINT_LEVEL = ("perzyna", "finite_strain")
+
 
 def _series(
     rows: list[dict],
@@ -29,7 +32,9 @@ def _series(
         and (transfer is None or r["transfer"] == transfer)
         and (method is None or r.get("method", "") == method)
     ]
-    return sorted(pts, key=lambda r: -float(r["h_um"]) if case != "perzyna" else -float(r["dt_s"]))
+    return sorted(
+        pts, key=lambda r: -float(r["h_um"]) if case not in POINT_LEVEL else -float(r["dt_s"])
+    )
 
 
 def observed_orders(hs: list[float], errs: list[float]) -> list[float]:
@@ -84,7 +89,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
     fig, axes = plt.subplots(math.ceil(n / cols), cols, figsize=(13, 2.8 * math.ceil(n / cols)))
     for ax, s in zip(axes.flat, cases, strict=False):
         pts = _series(rows, s.name, s.measure, *_own(s)[:1], "f64", _own(s)[1])
-        x = [float(r["dt_s"] if s.name == "perzyna" else r["h_um"]) for r in pts]
+        x = [float(r["dt_s"] if s.name in POINT_LEVEL else r["h_um"]) for r in pts]
         e = [abs(float(r["error"])) for r in pts]
         ax.loglog(x, e, "o-")
         orders = observed_orders(x, e)
@@ -92,7 +97,7 @@ def plot(rows: list[dict], out: Path, studies: tuple, transfers: dict) -> list[P
             xm, ym = math.sqrt(x[i] * x[i + 1]), math.sqrt(max(e[i] * e[i + 1], 1e-300))
             ax.annotate(f"{p:.1f}", (xm, ym), fontsize=8, color="C3")
         ax.set_title(f"{s.name}: {s.measure}", fontsize=9)
-        ax.set_xlabel("dt (s)" if s.name == "perzyna" else "h (um)", fontsize=8)
+        ax.set_xlabel("dt (s)" if s.name in POINT_LEVEL else "h (um)", fontsize=8)
         ax.tick_params(labelsize=7)
     for ax in list(axes.flat)[n:]:
         ax.axis("off")
@@ -182,7 +187,7 @@ def summary_table(rows: list[dict], studies: tuple) -> str:
                 pts = _series(rows, s.name, m, transfer, "f64", method)
                 if not pts:
                     continue
-                x = [float(r["dt_s"] if s.name == "perzyna" else r["h_um"]) for r in pts]
+                x = [float(r["dt_s"] if s.name in POINT_LEVEL else r["h_um"]) for r in pts]
                 e = [float(r["error"]) for r in pts]
                 cells = ", ".join(
                     f"{float(r['resolution']):g}: {float(r['error']):+.2e}" for r in pts

@@ -1,5 +1,6 @@
 """Perzyna overstress viscoplasticity (the solver's backward-Euler return map): stress relaxation
-at fixed strain, constant-rate pure shear (continuous closed form and step-by-step discrete)."""
+at fixed strain, constant-rate pure shear (continuous closed form and step-by-step discrete);
+its zero-yield limit, the Maxwell fluid (relaxation and simple shear)."""
 
 from __future__ import annotations
 
@@ -128,3 +129,16 @@ def perzyna_shear_discrete(
         s, a, _ = perzyna_step(s + ds, a, dt, mu, sigma_Y, H, eta)
         s_out[n], a_out[n] = s, a
     return dt * np.arange(n_steps + 1), s_out, a_out
+
+
+def maxwell_relaxation(t: ArrayLike, s0: float, tau: float) -> float | np.ndarray:
+    """Deviatoric stress of a Maxwell fluid held at a fixed deformation: s0 exp(-t / tau),
+    tau = eta / (2 mu) (the Perzyna model with sigma_Y = H = 0: ds/dt = 2 mu D - s / tau)."""
+    return out(s0 * np.exp(-np.asarray(t, dtype=float) / tau))
+
+
+def maxwell_shear_stress(t: ArrayLike, rate: float, mu: float, tau: float) -> float | np.ndarray:
+    """Shear stress of a Maxwell fluid in simple shear v_x = rate y from rest, small strain:
+    s_xy = mu rate tau (1 - exp(-t / tau)) = (eta / 2) rate (1 - exp(-t / tau)) (D_xy =
+    rate / 2; the model's Newtonian viscosity is eta / 2, references.capillarity)."""
+    return out(mu * rate * tau * -np.expm1(-np.asarray(t, dtype=float) / tau))

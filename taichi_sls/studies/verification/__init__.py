@@ -20,13 +20,14 @@ from .capillarity import (
 from .common import Result
 from .heat import run_energy, run_erf, run_gaussian, run_stefan
 from .hopper import run_hopper
-from .mechanics import perzyna_history, run_bar, run_perzyna, run_steffen
+from .mechanics import perzyna_history, run_bar, run_finite_strain, run_perzyna, run_steffen
 from .spec import VerificationCase, case_names, case_path, load, load_file
 
 RUNNERS: dict[str, Callable[[VerificationCase], Result]] = {
     "bar": run_bar,
     "steffen": run_steffen,
     "perzyna": run_perzyna,
+    "finite_strain": run_finite_strain,
     "erf": run_erf,
     "gaussian": run_gaussian,
     "stefan": run_stefan,

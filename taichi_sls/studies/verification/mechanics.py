@@ -1,5 +1,5 @@
 """Verification of the mechanics: the vibrating bar, the manufactured solution, the Perzyna
-return map at one point."""
+return map at one point, the finite-strain update at one point."""
 
 import math
 import time
@@ -97,6 +97,137 @@ def perzyna_history(mat: Material, strains: np.ndarray, dt: float) -> tuple[np.n
     return r[:, 0], r[:, 1]
 
 
+def elastic_state(mat: Material, e0: np.ndarray, xi: float) -> tuple[np.ndarray, np.ndarray]:
+    """(Fe, sigma) of a point at rest (J = 1) carrying the symmetric 3x3 elastic strain e0 at
+    solid fraction xi: the stretch exp(e0) of the finite form and Hooke's stress, which is its
+    Hencky stress too."""
+    E = xi * mat.youngs_solid_Pa + (1 - xi) * mat.youngs_liquid_Pa
+    nu = xi * mat.poisson + (1 - xi) * mat.poisson_liquid
+    mu, K = E / (2 * (1 + nu)), E / (3 * (1 - 2 * nu))
+    w, Q = np.linalg.eigh(e0)
+    tr = np.trace(e0)
+    sig = K * tr * np.eye(3) + 2 * mu * (e0 - tr / 3 * np.eye(3))
+    return Q @ np.diag(np.exp(w)) @ Q.T, sig
+
+
+def constitutive_history(
+    mat: Material,
+    incs: np.ndarray,
+    dt: float,
+    *,
+    strain: str = "finite",
+    e0: np.ndarray | None = None,
+    xi: np.ndarray | None = None,
+    plastic: bool = True,
+    T_K: float = 300.0,
+) -> np.ndarray:
+    """Drive one point of the solver's stress update through prescribed relative deformation
+    gradients ``incs`` (n, 3, 3; f = I + dt L, f_zz = 1 in plane strain) from the elastic
+    strain e0 at rest (F = I). ``strain``: "finite" (constitutive.hencky_update) or "small" (the
+    incremental form, constitutive.perzyna_increment, with d eps = sym(f) - I); ``xi``: the
+    solid fraction of every step (default solid). Returns the Cauchy stress after every step
+    (n, 3, 3)."""
+    from ...physics.materials import material_struct
+    from ...solver.params import material_values
+    from ...solver.simulation import init_taichi
+
+    init_taichi(optimize=False)
+    n = len(incs)
+    xs = np.ones(n) if xi is None else np.asarray(xi, dtype=float)
+    Fe0, sig0 = elastic_state(mat, np.zeros((3, 3)) if e0 is None else e0, float(xs[0]))
+    mf = material_struct().field(shape=1)
+    mf.from_numpy({k: np.array([v]) for k, v in material_values(mat, 0.0).items()})
+    out = np.zeros((n, 3, 3))
+    _drive(
+        mf,
+        np.ascontiguousarray(incs, dtype=float),
+        np.ascontiguousarray(xs),
+        np.stack([Fe0, sig0]),
+        out,
+        dt,
+        T_K,
+        strain == "finite",
+        plastic,
+    )
+    return out
+
+
+def _drive_kernel():
+    """The point driver of :func:`constitutive_history`, built once (ndarray arguments: one
+    compile, which Taichi's offline cache keeps across re-initialisations)."""
+    import taichi as ti
+
+    from ...physics.constitutive import SQRT23, hencky_update, perzyna_increment
+
+    @ti.func
+    def mat3(a: ti.template(), k):
+        m = ti.Matrix.zero(float, 3, 3)
+        for i, j in ti.static(ti.ndrange(3, 3)):
+            m[i, j] = a[k, i, j]
+        return m
+
+    @ti.kernel
+    def drive(
+        mf: ti.template(),
+        f_in: ti.types.ndarray(),
+        x_in: ti.types.ndarray(),
+        start: ti.types.ndarray(),
+        out: ti.types.ndarray(),
+        dt: float,
+        T_K: float,
+        finite: ti.template(),
+        plastic: ti.template(),
+    ):
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            I3 = ti.Matrix.identity(float, 3)
+            Fe, sig, F = mat3(start, 0), mat3(start, 1), I3
+            alpha, xl = 0.0, x_in[0]
+            for k in range(f_in.shape[0]):
+                f = mat3(f_in, k)
+                F = f @ F
+                dgam = 0.0
+                if ti.static(finite):
+                    sig, Fe, dgam, _n = hencky_update(
+                        mf[0], Fe, xl, alpha, f, 0.0, x_in[k], T_K, F.determinant(), dt,
+                        plastic, 2,
+                    )  # fmt: skip
+                    xl = x_in[k]
+                else:
+                    deps = 0.5 * (f + f.transpose()) - I3
+                    sig, dgam, _n = perzyna_increment(
+                        mf[0], sig, deps, 0.0, alpha, x_in[k], T_K, dt, plastic
+                    )
+                alpha += SQRT23 * dgam
+                for i, j in ti.static(ti.ndrange(3, 3)):
+                    out[k, i, j] = sig[i, j]
+
+    return drive
+
+
+def _drive(*args) -> None:
+    global _DRIVE
+    if _DRIVE is None:
+        _DRIVE = _drive_kernel()
+    _DRIVE(*args)
+
+
+_DRIVE = None
+
+
+def rotation_increment(dtheta: float) -> np.ndarray:
+    """The exact in-plane rotation by dtheta as a relative deformation gradient (3x3)."""
+    c, s = math.cos(dtheta), math.sin(dtheta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def shear_increment(rate: float, dt: float) -> np.ndarray:
+    """f = I + dt L of simple shear v_x = rate y."""
+    f = np.eye(3)
+    f[0, 1] = rate * dt
+    return f
+
+
 def run_perzyna(vc: VerificationCase) -> Result:
     """Perzyna return map at one point (eqs. 40-45), time step dt = case.time.dt_s:
 
@@ -149,4 +280,75 @@ def run_perzyna(vc: VerificationCase) -> Result:
         transfer=transfer_label(case),  # no grid transfer: the label keeps the rows together
         precision=case.solver.precision,
         info={"tau_s": eta / (2 * mu), "overstress_at_hold": float(f[n_load - 1])},
+    )
+
+
+def run_finite_strain(vc: VerificationCase) -> Result:
+    """The finite-strain update (solver.strain = "finite", constitutive.hencky_update) at one
+    point of a Maxwell material (zero yield; viscosity_model = "constant"), dt = case.time.dt_s,
+    n = end_s / dt steps:
+
+    - ``maxwell_relaxation``: a point prestressed in shear (hold_strain) held at rest, max
+      deviator error against s0 exp(-t / tau) (references.maxwell_relaxation) / s0;
+    - ``maxwell_shear``: simple shear at shear_rate_1_s from rest, max shear stress error
+      against mu rate tau (1 - exp(-t / tau)) (references.maxwell_shear_stress) / its steady
+      value (first order in dt, plus the finite-strain terms of order (rate tau)^2);
+    - ``quarter_turn``: the prestressed point (elastic) turned by a quarter turn in n exact
+      rotation increments, max |sigma - R sigma0 R^T| / |sigma0| (round-off);
+    - ``full_turn_invariants``: a full turn in n increments, max relative drift of pressure
+      and von Mises stress (round-off).
+    """
+    case = vc.case
+    t0 = time.perf_counter()
+    mat = material(case)
+    v = vc.spec
+    if mat.viscosity_model != "constant":
+        raise CaseError("verification.kind = 'finite_strain': needs viscosity_model = 'constant'")
+    mu = mat.youngs_solid_Pa / (2 * (1 + mat.poisson))
+    tau = mat.viscosity_Pas / (2 * mu)
+    dt = float(case.time.dt_s)
+    n = int(round(case.time.end_s / dt))
+    t = dt * np.arange(1, n + 1)
+    e0 = np.zeros((3, 3))
+    e0[0, 1] = e0[1, 0] = v.hold_strain
+    sig0 = elastic_state(mat, e0, 1.0)[1]
+    rest = constitutive_history(mat, np.tile(np.eye(3), (n, 1, 1)), dt, e0=e0)
+    relax = np.abs(rest[:, 0, 1] - ref.maxwell_relaxation(t, sig0[0, 1], tau)).max()
+    shear = constitutive_history(mat, np.tile(shear_increment(v.shear_rate_1_s, dt), (n, 1, 1)), dt)
+    steady = mu * v.shear_rate_1_s * tau
+    shear_err = np.abs(shear[:, 0, 1] - ref.maxwell_shear_stress(t, v.shear_rate_1_s, mu, tau))
+    quarter = rotation_increment(0.5 * math.pi)
+    q = constitutive_history(
+        mat, np.tile(rotation_increment(0.5 * math.pi / n), (n, 1, 1)), dt, e0=e0, plastic=False
+    )[-1]
+    full = constitutive_history(
+        mat, np.tile(rotation_increment(2 * math.pi / n), (n, 1, 1)), dt, e0=e0, plastic=False
+    )
+
+    def drift(x: np.ndarray, x0: float) -> float:
+        return float(np.abs(x / x0 - 1.0).max()) if x0 != 0.0 else float(np.abs(x).max())
+
+    p = np.trace(full, axis1=1, axis2=2) / 3
+    dev = full - p[:, None, None] * np.eye(3)
+    dev0 = sig0 - np.trace(sig0) / 3 * np.eye(3)
+    mises = np.sqrt(1.5 * (dev * dev).sum(axis=(1, 2)))
+    scale = float(np.abs(sig0).max())
+    errors = {
+        "maxwell_relaxation": float(relax / abs(sig0[0, 1])),
+        "maxwell_shear": float(shear_err.max()) / steady,
+        "quarter_turn": float(np.abs(q - quarter @ sig0 @ quarter.T).max()) / scale,
+        "full_turn_invariants": max(
+            float(np.abs(p - np.trace(sig0) / 3).max()) / scale,
+            drift(mises, float(np.sqrt(1.5 * (dev0 * dev0).sum()))),
+        ),
+    }
+    return Result(
+        case=case.case.name,
+        h_um=case.grid.spacing_um,
+        dt_s=dt,
+        errors=errors,
+        wall_s=time.perf_counter() - t0,
+        steps=4 * n,
+        transfer=transfer_label(case),  # no grid transfer: the label keeps the rows together
+        precision=case.solver.precision,
     )

@@ -8,6 +8,7 @@ data before the case is validated. Resolution parameter of :func:`load`, by kind
 - ``curvature``, ``laplace``, ``viscous_decay``, ``inviscid``: R/h of the disc;
 - ``hopper``: R0/h of each cylinder (touching discs, or Hopper's outline at hopper_tau0);
 - ``perzyna``: time steps over the constant-rate drive;
+- ``finite_strain``: time steps over end_s (the Maxwell drives) and increments of the full turn;
 - every other kind: the grid spacing in um.
 """
 
@@ -31,6 +32,7 @@ Kind = Literal[
     "bar",
     "steffen",
     "perzyna",
+    "finite_strain",
     "erf",
     "gaussian",
     "stefan",
@@ -69,10 +71,16 @@ class VerificationSpec(Model):
         0.0, description="gaussian: initial peak rise over thermal.initial_C, rise exp(-r^2/2 s0^2)"
     )
     shear_rate_1_s: float = Field(
-        0.0, ge=0, description="perzyna: engineering shear rate of the constant-rate drive (1/s)"
+        0.0,
+        ge=0,
+        description="perzyna: engineering shear rate of the constant-rate drive (1/s); "
+        "finite_strain: rate of the simple shear v_x = rate y (1/s)",
     )
     hold_strain: float = Field(
-        0.0, ge=0, description="perzyna: shear strain eps_xy held fixed for the relaxation check"
+        0.0,
+        ge=0,
+        description="perzyna: shear strain eps_xy held fixed for the relaxation check; "
+        "finite_strain: the elastic shear strain of the prestressed point (relaxation, rotation)",
     )
     hopper_tau0: float = Field(
         0.0,
@@ -133,7 +141,7 @@ def _check(case: Case, v: VerificationSpec) -> None:
         need("sigma_um", v.sigma_um, "the initial width")
         if not case.physics.thermal:
             raise CaseError("verification.kind = 'gaussian': needs physics.thermal = true")
-    elif v.kind == "perzyna":
+    elif v.kind in ("perzyna", "finite_strain"):
         need("shear_rate_1_s", v.shear_rate_1_s, "the constant-rate drive")
         need("hold_strain", v.hold_strain, "the relaxation check")
 
@@ -225,7 +233,7 @@ def load(name: str, resolution: float | None = None, sets: dict | None = None) -
             slab_length(data, float(resolution), data["domain"]["width_um"])
         elif kind == "hopper":
             hopper_geometry(data, float(resolution))
-        elif kind == "perzyna":
+        elif kind in ("perzyna", "finite_strain"):
             data.setdefault("time", {})["dt_s"] = data["time"]["end_s"] / int(resolution)
             data["time"]["allow_unstable_dt"] = True  # a point-level drive: no grid limit
         else:
