@@ -14,9 +14,9 @@ from ..config import Case
 from ..physics.materials import KELVIN
 from . import checkpoint
 from .blocks import BlockPlan
+from .contacts import neck_width, touching
 from .fields import State
 from .guard import Guard
-from .contacts import neck_width, touching
 from .monitor import body_centroids_x, neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
@@ -219,9 +219,12 @@ class Simulation:
         x = self.state.points.x.to_numpy()
         body, m = self.scene.body, self._mass
         n_b = len(self._body_radius)
-        centre = np.stack(
-            [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
-        ) / np.bincount(body, weights=m, minlength=n_b)[:, None]
+        centre = (
+            np.stack(
+                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
+            )
+            / np.bincount(body, weights=m, minlength=n_b)[:, None]
+        )
         cfg = self.state.cfg
         out = []
         for a, b in self.contacts:
