@@ -9,7 +9,7 @@ import pytest
 from helpers import PAPER_SCENE, deep_update, make_case
 
 from taichi_sls.jobs.case_run import run_case
-from taichi_sls.jobs.outcome import NeckHistory, outcome
+from taichi_sls.jobs.outcome import NeckHistory, describe, outcome
 from taichi_sls.jobs.schedule import frame_steps, settled
 
 
@@ -52,8 +52,11 @@ def _history(necks, molten, times):
     return h
 
 
+LASER = {"lasers": [{"power_W": 25.0}]}
+
+
 def test_verdict_follows_its_rule():
-    case = _case({})
+    case = _case(LASER)
     h = _history([8.0, 8.5, 9.0, 9.0], [0.0, 0.9, 0.0, 0.0], [0.0, 1e-3, 2e-2, 5e-2])
     final = {"contact_line_um": 9.0, "T_peak_C": 300.0}
     in_neck = np.array([True, True, False])
@@ -70,6 +73,40 @@ def test_verdict_follows_its_rule():
     # grew less than the margin
     small = {"contact_line_um": 8.2, "T_peak_C": 300.0}
     assert outcome(case, h, small, melted, in_neck, solidified=True)["fused"] is False
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        {},  # no [[lasers]] at all
+        {"lasers": [{"power_W": 0.0}]},
+        {**LASER, "physics": {"thermal": False}},  # an isothermal run: the beam heats nothing
+    ],
+)
+def test_no_verdict_without_a_laser(extra):
+    """A pair that coalesces with no laser (Hopper's isothermal discs) is neither fused nor not
+    fused by a laser: the verdict is null and the summary and printout say why."""
+    h = _history([8.0, 12.0], [0.0, 0.0], [0.0, 1e-3])
+    o = outcome(
+        _case(extra),
+        h,
+        {"contact_line_um": 12.0, "T_peak_C": 140.0},
+        np.array([1e-3, 1e-3]),
+        np.array([True, True]),
+        solidified=True,
+    )
+    assert o["fused"] is None and o["no_verdict"] == "no laser in this case"
+    assert describe(o).startswith("outcome: no verdict (no laser in this case)")
+    assert "NOT FUSED" not in describe(o)
+    with_laser = outcome(
+        _case(LASER),
+        h,
+        {"contact_line_um": 12.0, "T_peak_C": 300.0},
+        np.array([1e-3, 1e-3]),
+        np.array([True, True]),
+        solidified=True,
+    )
+    assert with_laser["fused"] is True and with_laser["no_verdict"] is None
 
 
 # a run to solidification in seconds: coarse grid, the inertia scaled so that the step is the
