@@ -137,12 +137,18 @@ class Laser(Model):
 
 class Output(Model):
     frames: int = Field(
-        20, gt=0, le=100000, description="number of output frames over the run (linear spacing)"
+        20,
+        gt=0,
+        le=100000,
+        description="number of output frames over the run (linear spacing only; log spacing "
+        "sets them by frames_per_decade)",
     )
     spacing: Literal["auto", "linear", "log"] = Field(
         "auto",
-        description="frame times: linear (frames over end_s), log (frames_per_decade from "
-        'first_frame_s); auto: linear for stop = "end", log for "solidified"',
+        description="frame and time-series row times: linear (frames over end_s), log "
+        "(frames_per_decade from first_frame_s, so that the microsecond melting transient is "
+        'seen); auto: log for stop = "solidified" and for any case a laser heats (31 frames '
+        "to 1 ms by default), linear otherwise (e.g. an isothermal coalescence)",
     )
     frames_per_decade: int = Field(10, gt=0, le=1000, description="log spacing: frames per decade")
     first_frame_s: float = Field(1e-6, gt=0, description="log spacing: time of the first frame")

@@ -36,6 +36,19 @@ def test_log_frames_hit_1ms_and_stop_at_max_time():
     assert len(steps) == 46  # 10 per decade from 1 us to 30 ms, plus the end
 
 
+def test_a_laser_case_to_1ms_shows_its_transient_frame_by_frame():
+    """The pair melts within 20 us and its neck is set within 0.1 ms: a laser case's frames are
+    log-spaced by default, with 1 ms the last; spacing = "linear" keeps the old frames."""
+    dt = 5e-8
+    laser = {"lasers": [{"power_W": 25.0}], "time": {"end_s": 1e-3}}
+    t = np.array(list(frame_steps(_case(laser), dt))) * dt
+    assert len(t) == 31 and t[-1] == pytest.approx(1e-3)  # 10 per decade from 1 us
+    assert np.sum(t <= 2e-5) >= 13 and np.sum(t <= 1e-4) >= 20
+    linear = deep_update(laser, {"output": {"spacing": "linear"}})
+    t = np.array(list(frame_steps(_case(linear), dt))) * dt
+    assert len(t) == 20 and t[0] == pytest.approx(5e-5)
+
+
 def test_settled_needs_lasers_off_solid_and_quiet():
     case = _case({"lasers": [{"power_W": 25.0, "off_s": 2e-5}], "time": {"stop": "solidified"}})
     quiet = {"molten_fraction": 0.0, "T_max_C": 145.0, "kinetic_ratio": 1e-9}
