@@ -1,7 +1,14 @@
-"""Frame images: the points coloured by temperature (melt outlined) and by deformation.
+"""Frame images: the material coloured by temperature (melt outlined) and by deformation.
+
+The points are drawn as the material they stand for, rasterised at screen resolution: each
+point spreads its area and its field over a tent a few point spacings wide, and the pixels whose
+area fraction reaches 1/2 are material (for a regular lattice the level falls half a spacing
+beyond the last row, on the body's true outline). Squares drawn at each point instead show the
+empty strip, about one point spacing wide, that two coalescing bodies keep along their symmetry
+line (no point crosses it) as a column of white dashes that reads as a crack.
 
 Plotting is headless (Agg) and reuses one figure across frames so memory stays flat over
-hundreds of frames; the axes box is fixed so that the marker scale is the same in every frame."""
+hundreds of frames; the axes box is fixed so that the raster is the same in every frame."""
 
 from __future__ import annotations
 
@@ -18,10 +25,17 @@ matplotlib.use("Agg")  # headless: the solver runs on machines without a display
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from scipy.ndimage import correlate1d
 
 from .atomic import atomic_write_bytes
 
 MELT_LEVEL = 0.5  # liquid fraction drawn as the melt outline
+MATERIAL_LEVEL = 0.5  # area fraction drawn as material: the outline of a regular lattice
+# Half-width of the tent that spreads a point, in point spacings. At 3 the strip of a coalescing
+# pair (its points 2 spacings apart across it) reads 2/3 and is filled, a gap of 3 spacings
+# (0.44) stays open, and a flat free surface keeps its level 1/2 half a spacing out.
+FOOTPRINT_SPACINGS = 3.0
+_MAX_RASTER_PIXELS = 1200  # per axis; bounds the raster at a high dpi
 _MAX_CONTOUR_CELLS = 400  # per axis; bounds the melt-outline grid if points fly far apart
 DEFORM_LABELS = {
     "displacement": ("|u| [um]", "displacement"),
@@ -29,7 +43,7 @@ DEFORM_LABELS = {
 }
 
 
-def _point_spacing(x: np.ndarray, fallback: float) -> float:
+def point_spacing(x: np.ndarray, fallback: float) -> float:
     """Typical particle spacing sqrt(area per point), from a sample of local point densities.
 
     Counting neighbours within a few nearest-neighbour distances (rather than using the
@@ -102,6 +116,50 @@ def _melt_grid(
     return xc, yc, vals
 
 
+def material_raster(
+    x: np.ndarray,
+    values: list[np.ndarray],
+    spacing: float,
+    lo: tuple[float, float],
+    shape: tuple[int, int],
+    pixel: float,
+) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The points as material on a raster of ``shape`` (ny, nx) pixels of side ``pixel`` from
+    corner ``lo``: the area fraction (points of area ``spacing``^2 spread over a tent of
+    half-width FOOTPRINT_SPACINGS spacings) and each of ``values`` as the area-weighted mean of
+    the points nearby (NaN where none has a finite value)."""
+    ny, nx = shape
+    ok = np.isfinite(x).all(axis=1)
+    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64) if ok.any() else None
+    inside = (
+        np.zeros(0, dtype=bool)
+        if ij is None
+        else ((ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny))
+    )
+    flat = np.zeros(0, dtype=np.int64) if ij is None else ij[inside, 1] * nx + ij[inside, 0]
+    half = int(FOOTPRINT_SPACINGS * spacing / pixel)
+    taps = 1.0 - np.abs(np.arange(-half, half + 1)) * pixel / (FOOTPRINT_SPACINGS * spacing)
+    taps /= taps.sum()  # discrete normalisation: a uniform lattice reads exactly 1
+
+    def spread(weights: np.ndarray) -> np.ndarray:
+        binned = np.bincount(flat, weights=weights, minlength=nx * ny).astype(float)  # int if empty
+        binned = binned.reshape(ny, nx)
+        return correlate1d(
+            correlate1d(binned, taps, axis=0, mode="constant"), taps, axis=1, mode="constant"
+        )
+
+    area = spacing * spacing
+    fraction = spread(np.full(flat.size, area)) / (pixel * pixel)
+    out = []
+    for v in values:
+        v = np.asarray(v, dtype=float)[ok][inside]
+        good = np.isfinite(v)
+        num = spread(np.where(good, v * area, 0.0))
+        den = spread(np.where(good, area, 0.0))
+        out.append(np.divide(num, den, out=np.full_like(num, np.nan), where=den > 0.0))
+    return fraction, out
+
+
 def save_png(fig: Figure, path: Path, dpi: int) -> None:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
@@ -112,11 +170,16 @@ class FramePainter:
     """Draws one frame into a reused figure of two panels (temperature, deformation)."""
 
     def __init__(
-        self, domain_um: tuple[float, float, float, float], melt_C: float, deformation: str
+        self,
+        domain_um: tuple[float, float, float, float],
+        melt_C: float,
+        deformation: str,
+        dpi: int = 80,
     ) -> None:
         self.domain_um = domain_um
         self.melt_C = melt_C
         self.deformation = deformation
+        self.dpi = dpi  # the raster's pixel is one pixel of the saved image
         self._fig: Figure | None = None
 
     def _setup_figure(self) -> None:
@@ -125,12 +188,21 @@ class FramePainter:
         panel_h = min(max(panel_w * (ymax - ymin) / (xmax - xmin), 1.5), 6.0)
         fig = Figure(figsize=(2 * panel_w + 1.4, panel_h + 1.0))
         FigureCanvasAgg(fig)
-        # Fixed layout (not constrained) so the axes box -- and so the marker scale -- is known
-        # before drawing and identical across frames.
+        # Fixed layout (not constrained) so the axes box -- and so the raster -- is known before
+        # drawing and identical across frames.
         fig.subplots_adjust(left=0.06, right=0.93, bottom=0.14, top=0.86, wspace=0.38)
         axes = fig.subplots(1, 2)
+        # Image pixels per micrometre under equal aspect: the tighter of the two directions.
+        pos = axes[0].get_position()
+        w_in, h_in = fig.get_figwidth() * pos.width, fig.get_figheight() * pos.height
+        px_per_um = self.dpi * min(w_in / (xmax - xmin), h_in / (ymax - ymin))
+        self._pixel = max(1.0 / px_per_um, max(xmax - xmin, ymax - ymin) / _MAX_RASTER_PIXELS)
+        nx = max(1, math.ceil((xmax - xmin) / self._pixel))
+        ny = max(1, math.ceil((ymax - ymin) / self._pixel))
+        self._shape = (ny, nx)
+        extent = (xmin, xmin + nx * self._pixel, ymin, ymin + ny * self._pixel)
         cb_label, name = DEFORM_LABELS[self.deformation]
-        self._scatters, self._cbars = [], []
+        self._images, self._cbars = [], []
         for ax, cmap, label, title in zip(
             axes,
             ("inferno", "viridis"),
@@ -138,21 +210,21 @@ class FramePainter:
             ("temperature (cyan: melt)", name),
             strict=True,
         ):
-            sc = ax.scatter(
-                np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", linewidths=0
+            im = ax.imshow(
+                np.ma.masked_all(self._shape),
+                cmap=cmap,
+                origin="lower",
+                extent=extent,
+                interpolation="nearest",  # one raster pixel per image pixel already
             )
-            self._cbars.append(fig.colorbar(sc, ax=ax, label=label, fraction=0.046, pad=0.03))
-            self._scatters.append(sc)
+            self._cbars.append(fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03))
+            self._images.append(im)
             ax.set_xlim(xmin, xmax)
             ax.set_ylim(ymin, ymax)
             ax.set_aspect("equal", adjustable="box")
             ax.set_xlabel("x [um]")
             ax.set_ylabel("y [um]")
             ax.set_title(title, fontsize=10)
-        # Points per micrometre under equal aspect: the tighter of the two directions.
-        pos = axes[0].get_position()
-        w_pt, h_pt = fig.get_figwidth() * pos.width * 72, fig.get_figheight() * pos.height * 72
-        self._pt_per_um = min(w_pt / (xmax - xmin), h_pt / (ymax - ymin))
         self._axes, self._contour, self._fig = axes, None, fig
 
     def draw(self, t_s: float, x: np.ndarray, fields: dict[str, np.ndarray]) -> None:
@@ -160,18 +232,18 @@ class FramePainter:
             self._setup_figure()
         fallback = (
             self.domain_um[1] - self.domain_um[0]
-        ) / 100  # lone or coincident points: a small visible square
-        h = _point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
-        # Square side 1.5 h so neighbouring markers overlap: reads as a continuous body.
-        size = max((1.5 * h * self._pt_per_um) ** 2, 0.5)
+        ) / 100  # lone or coincident points: a small visible patch
+        h = point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
         T, d = fields["T_C"], fields["deform"]
+        fraction, rasters = material_raster(
+            x, [T, d], h, (self.domain_um[0], self.domain_um[2]), self._shape, self._pixel
+        )
+        material = fraction >= MATERIAL_LEVEL
         # T range always includes melt_C and |u| starts at 0, so colours keep their meaning.
         limits = (_finite_range(T, hi=self.melt_C), _finite_range(d, lo=0.0))
-        for sc, v, clim in zip(self._scatters, (T, d), limits, strict=True):
-            sc.set_offsets(x)
-            sc.set_array(v)
-            sc.set_sizes(np.array([size]))
-            sc.set_clim(*clim)
+        for im, v, clim in zip(self._images, rasters, limits, strict=True):
+            im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
+            im.set_clim(*clim)
         if self._contour is not None:
             with contextlib.suppress(Exception):
                 self._contour.remove()
