@@ -110,7 +110,7 @@ class Laser(Model):
     power_W: float = Field(25.0, ge=0, description="P")
     spot_radius_um: float = Field(50.0, gt=0, description="r_0")
     absorptivity: float = Field(
-        0.85, ge=0, description="A (fraction, MODEL.md reads 0.85 % as 0.85)"
+        0.85, ge=0, description="A (fraction, docs/model.md reads 0.85 % as 0.85)"
     )
     penetration_depth_um: float = Field(100.0, gt=0, description="eta_l")
     depth_factor: float = Field(0.6, ge=0, description="the 0.6 prefactor of eq. 31")
@@ -126,12 +126,13 @@ class Laser(Model):
     )
     source_units: Literal["W_per_m3", "W_per_kg"] = Field(
         "W_per_m3",
-        description="eq. 31 read as W/m^3 (MODEL.md) or, as printed in eq. 3, W/kg multiplied "
+        description="eq. 31 read as W/m^3 (docs/model.md) or, as printed in eq. 3, W/kg multiplied "
         "by rho",
     )
     depth_sign: Literal["decay", "paper"] = Field(
         "decay",
-        description="decay: exp(-(y_l - y)/eta) (MODEL.md); paper: exp(+(y_l - y)/eta) as printed",
+        description="decay: exp(-(y_l - y)/eta) (docs/model.md); paper: exp(+(y_l - y)/eta) as "
+        "printed",
     )
 
 
