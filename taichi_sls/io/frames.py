@@ -35,8 +35,8 @@ MATERIAL_LEVEL = 0.5  # area fraction drawn as material: the outline of a regula
 # pair (its points 2 spacings apart across it) reads 2/3 and is filled, a gap of 3 spacings
 # (0.44) stays open, and a flat free surface keeps its level 1/2 half a spacing out.
 FOOTPRINT_SPACINGS = 3.0
+MIN_MARKER_PT2 = 0.5  # a stray point's marker never shrinks below visibility
 _MAX_RASTER_PIXELS = 1200  # per axis; bounds the raster at a high dpi
-_MAX_CONTOUR_CELLS = 400  # per axis; bounds the melt-outline grid if points fly far apart
 DEFORM_LABELS = {
     "displacement": ("|u| [um]", "displacement"),
     "plastic_strain": ("equivalent plastic strain", "plastic strain"),
@@ -87,35 +87,6 @@ def _finite_range(
     return vmin, vmax
 
 
-def _melt_grid(
-    x: np.ndarray, lf: np.ndarray, h: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Bin liquid fraction on a grid of cell ``h``; empty cells count as solid (0).
-
-    Contouring this grid at 0.5 is robust for any point set (no triangulation that could fail
-    on collinear/duplicate points or bridge gaps between particles), and cheap (bincount).
-    Returns (xc, yc, values) or None when there is no liquid/solid boundary to draw.
-    """
-    ok = np.isfinite(x).all(axis=1)
-    x, lf = x[ok], np.nan_to_num(lf[ok], nan=0.0)
-    if len(x) == 0 or not (lf > MELT_LEVEL).any():
-        return None
-    lo, hi = x.min(axis=0), x.max(axis=0)
-    h = max(h, float((hi - lo).max()) / _MAX_CONTOUR_CELLS, 1e-12)
-    lo = lo - 1.5 * h  # one empty ring all round closes the outline at free surfaces
-    nx, ny = (np.floor((hi - lo) / h).astype(int) + 3).tolist()
-    ij = np.floor((x - lo) / h).astype(int)
-    flat = ij[:, 1] * nx + ij[:, 0]
-    s = np.bincount(flat, weights=lf, minlength=nx * ny)
-    c = np.bincount(flat, minlength=nx * ny)
-    vals = np.divide(s, c, out=np.zeros_like(s), where=c > 0).reshape(ny, nx)
-    if not (vals < MELT_LEVEL).any():
-        return None
-    xc = lo[0] + (np.arange(nx) + 0.5) * h
-    yc = lo[1] + (np.arange(ny) + 0.5) * h
-    return xc, yc, vals
-
-
 def material_raster(
     x: np.ndarray,
     values: list[np.ndarray],
@@ -160,6 +131,21 @@ def material_raster(
     return fraction, out
 
 
+def _on_material(
+    x: np.ndarray, material: np.ndarray, lo: tuple[float, float], pixel: float
+) -> np.ndarray:
+    """Which points lie on a material pixel (non-finite points and those off the raster: no)."""
+    ny, nx = material.shape
+    out = np.zeros(len(x), dtype=bool)
+    ok = np.isfinite(x).all(axis=1)
+    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64)
+    inside = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+    hit = np.zeros(len(ij), dtype=bool)
+    hit[inside] = material[ij[inside, 1], ij[inside, 0]]
+    out[ok] = hit
+    return out
+
+
 def save_png(fig: Figure, path: Path, dpi: int) -> None:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
@@ -196,13 +182,18 @@ class FramePainter:
         pos = axes[0].get_position()
         w_in, h_in = fig.get_figwidth() * pos.width, fig.get_figheight() * pos.height
         px_per_um = self.dpi * min(w_in / (xmax - xmin), h_in / (ymax - ymin))
+        self._pt_per_um = px_per_um * 72.0 / self.dpi  # marker sizes are in points
         self._pixel = max(1.0 / px_per_um, max(xmax - xmin, ymax - ymin) / _MAX_RASTER_PIXELS)
         nx = max(1, math.ceil((xmax - xmin) / self._pixel))
         ny = max(1, math.ceil((ymax - ymin) / self._pixel))
         self._shape = (ny, nx)
+        self._pixel_centres = (
+            xmin + (np.arange(nx) + 0.5) * self._pixel,
+            ymin + (np.arange(ny) + 0.5) * self._pixel,
+        )
         extent = (xmin, xmin + nx * self._pixel, ymin, ymin + ny * self._pixel)
         cb_label, name = DEFORM_LABELS[self.deformation]
-        self._images, self._cbars = [], []
+        self._images, self._strays, self._cbars = [], [], []
         for ax, cmap, label, title in zip(
             axes,
             ("inferno", "viridis"),
@@ -219,6 +210,10 @@ class FramePainter:
             )
             self._cbars.append(fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03))
             self._images.append(im)
+            # points too isolated to make material (a lone point, one thrown off) stay visible
+            self._strays.append(
+                ax.scatter(np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", lw=0)
+            )
             ax.set_xlim(xmin, xmax)
             ax.set_ylim(ymin, ymax)
             ax.set_aspect("equal", adjustable="box")
@@ -235,27 +230,38 @@ class FramePainter:
         ) / 100  # lone or coincident points: a small visible patch
         h = point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
         T, d = fields["T_C"], fields["deform"]
-        fraction, rasters = material_raster(
-            x, [T, d], h, (self.domain_um[0], self.domain_um[2]), self._shape, self._pixel
+        lf = np.nan_to_num(np.asarray(fields["liquid_fraction"], dtype=float), nan=0.0)
+        fraction, (T_px, d_px, lf_px) = material_raster(
+            x, [T, d, lf], h, (self.domain_um[0], self.domain_um[2]), self._shape, self._pixel
         )
         material = fraction >= MATERIAL_LEVEL
         # T range always includes melt_C and |u| starts at 0, so colours keep their meaning.
         limits = (_finite_range(T, hi=self.melt_C), _finite_range(d, lo=0.0))
-        for im, v, clim in zip(self._images, rasters, limits, strict=True):
+        stray = ~_on_material(x, material, (self.domain_um[0], self.domain_um[2]), self._pixel)
+        size = max((h * self._pt_per_um) ** 2, MIN_MARKER_PT2)  # the point's own footprint
+        for im, sc, v, p, clim in zip(
+            self._images, self._strays, (T_px, d_px), (T, d), limits, strict=True
+        ):
             im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
             im.set_clim(*clim)
+            sc.set_offsets(x[stray])
+            sc.set_array(np.asarray(p, dtype=float)[stray])
+            sc.set_sizes(np.array([size]))
+            sc.set_clim(*clim)
         if self._contour is not None:
             with contextlib.suppress(Exception):
                 self._contour.remove()
             self._contour = None
-        try:
-            grid = _melt_grid(x, fields["liquid_fraction"], 2.0 * h)
-            if grid is not None:
+        # The melt outline on the same raster, the void counting as solid: the outline closes
+        # along the free surface and, like the material, has no gap along the mid-plane strip.
+        melt = np.where(material, np.nan_to_num(lf_px, nan=0.0), 0.0)
+        if (melt > MELT_LEVEL).any():
+            try:
                 self._contour = self._axes[0].contour(
-                    *grid, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
+                    *self._pixel_centres, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
                 )
-        except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame to it
-            self._contour = None
+            except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
+                self._contour = None
         self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
 
     def save(self, path: Path, dpi: int) -> None:
