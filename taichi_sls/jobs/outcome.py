@@ -90,7 +90,7 @@ def outcome(
         "rule": (
             f"neck region melted through (>= {f.melted_through:g} of its points above T_m at "
             f"some time) and final neck >= (1 + {f.neck_growth:g}) x initial neck; needs a "
-            "solidified end state"
+            "solidified end state and a laser that heated"
         ),
         "solidified": solidified,
         "neck_initial_um": neck0,
