@@ -137,19 +137,21 @@ class Laser(Model):
 
 
 class Output(Model):
-    frames: int = Field(
-        20,
+    frames: int | None = Field(
+        None,
         gt=0,
         le=100000,
-        description="number of output frames over the run (linear spacing only; log spacing "
-        "sets them by frames_per_decade)",
+        description="number of output frames over the run, linearly spaced; setting it asks for "
+        'linear spacing under spacing = auto (stop = "end"). Unset: log spacing in a case a '
+        "laser heats, 20 linear frames otherwise",
     )
     spacing: Literal["auto", "linear", "log"] = Field(
         "auto",
         description="frame and time-series row times: linear (frames over end_s), log "
         "(frames_per_decade from first_frame_s, so that the microsecond melting transient is "
-        'seen); auto: log for stop = "solidified" and for any case a laser heats (31 frames '
-        "to 1 ms by default), linear otherwise (e.g. an isothermal coalescence)",
+        'seen); auto: log for stop = "solidified" and for a case a laser heats that does not '
+        "set frames (31 frames to 1 ms by default), linear otherwise (e.g. an isothermal "
+        "coalescence)",
     )
     frames_per_decade: int = Field(10, gt=0, le=1000, description="log spacing: frames per decade")
     first_frame_s: float = Field(1e-6, gt=0, description="log spacing: time of the first frame")

@@ -38,7 +38,8 @@ def test_log_frames_hit_1ms_and_stop_at_max_time():
 
 def test_a_laser_case_to_1ms_shows_its_transient_frame_by_frame():
     """The pair melts within 20 us and its neck is set within 0.1 ms: a laser case's frames are
-    log-spaced by default, with 1 ms the last; spacing = "linear" keeps the old frames."""
+    log-spaced by default, with 1 ms the last; spacing = "linear" or a number of frames keeps
+    the old linear frames."""
     dt = 5e-8
     laser = {"lasers": [{"power_W": 25.0}], "time": {"end_s": 1e-3}}
     t = np.array(list(frame_steps(_case(laser), dt))) * dt
@@ -47,6 +48,9 @@ def test_a_laser_case_to_1ms_shows_its_transient_frame_by_frame():
     linear = deep_update(laser, {"output": {"spacing": "linear"}})
     t = np.array(list(frame_steps(_case(linear), dt))) * dt
     assert len(t) == 20 and t[0] == pytest.approx(5e-5)
+    # a case that asks for a number of frames keeps them linear under spacing = auto
+    t = np.array(list(frame_steps(_case(deep_update(laser, {"output": {"frames": 4}})), dt)))
+    assert len(t) == 4 and t[-1] * dt == pytest.approx(1e-3)
 
 
 def test_settled_needs_lasers_off_solid_and_quiet():
