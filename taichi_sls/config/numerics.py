@@ -129,7 +129,7 @@ class Solver(Model):
     )
     stress_reading: Literal["model", "paper"] = Field(
         "model",
-        description="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md); paper: eq. 39 "
+        description="model: s = 2 mu dev(eps_e), p = K tr(eps_e) (docs/model.md); paper: eq. 39 "
         'and p = lambda tr(eps) as printed (with stress_form = "total")',
     )
     stress_form: Literal["incremental", "total"] = Field(

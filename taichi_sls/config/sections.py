@@ -155,7 +155,7 @@ class Laser(Model):
     power_W: float = Field(25.0, ge=0, description="P")
     spot_radius_um: float = Field(50.0, gt=0, description="r_0")
     absorptivity: float = Field(
-        0.85, ge=0, description="A (fraction, MODEL.md reads 0.85 % as 0.85)"
+        0.85, ge=0, description="A (fraction, docs/model.md reads 0.85 % as 0.85)"
     )
     penetration_depth_um: float = Field(100.0, gt=0, description="eta_l")
     depth_factor: float = Field(0.6, ge=0, description="the 0.6 prefactor of eq. 31")
@@ -171,23 +171,32 @@ class Laser(Model):
     )
     source_units: Literal["W_per_m3", "W_per_kg"] = Field(
         "W_per_m3",
-        description="eq. 31 read as W/m^3 (MODEL.md) or, as printed in eq. 3, W/kg multiplied "
+        description="eq. 31 read as W/m^3 (docs/model.md) or, as printed in eq. 3, W/kg multiplied "
         "by rho",
     )
     depth_sign: Literal["decay", "paper"] = Field(
         "decay",
-        description="decay: exp(-(y_l - y)/eta) (MODEL.md); paper: exp(+(y_l - y)/eta) as printed",
+        description="decay: exp(-(y_l - y)/eta) (docs/model.md); paper: exp(+(y_l - y)/eta) as "
+        "printed",
     )
 
 
 class Output(Model):
-    frames: int = Field(
-        20, gt=0, le=100000, description="number of output frames over the run (linear spacing)"
+    frames: int | None = Field(
+        None,
+        gt=0,
+        le=100000,
+        description="number of output frames over the run, linearly spaced; setting it asks for "
+        'linear spacing under spacing = auto (stop = "end"). Unset: log spacing in a case a '
+        "laser heats, 20 linear frames otherwise",
     )
     spacing: Literal["auto", "linear", "log"] = Field(
         "auto",
-        description="frame times: linear (frames over end_s), log (frames_per_decade from "
-        'first_frame_s); auto: linear for stop = "end", log for "solidified"',
+        description="frame and time-series row times: linear (frames over end_s), log "
+        "(frames_per_decade from first_frame_s, so that the microsecond melting transient is "
+        'seen); auto: log for stop = "solidified" and for a case a laser heats that does not '
+        "set frames (31 frames to 1 ms by default), linear otherwise (e.g. an isothermal "
+        "coalescence)",
     )
     frames_per_decade: int = Field(10, gt=0, le=1000, description="log spacing: frames per decade")
     first_frame_s: float = Field(1e-6, gt=0, description="log spacing: time of the first frame")

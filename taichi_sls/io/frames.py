@@ -1,7 +1,14 @@
-"""Frame images: the points coloured by temperature (melt outlined) and by deformation.
+"""Frame images: the material coloured by temperature (melt outlined) and by deformation.
+
+The points are drawn as the material they stand for, rasterised at screen resolution: each
+point spreads its area and its field over a tent a few point spacings wide, and the pixels whose
+area fraction reaches 1/2 are material (for a regular lattice the level falls half a spacing
+beyond the last row, on the body's true outline). Squares drawn at each point instead show the
+empty strip, about one point spacing wide, that two coalescing bodies keep along their symmetry
+line (no point crosses it) as a column of white dashes that reads as a crack.
 
 Plotting is headless (Agg) and reuses one figure across frames so memory stays flat over
-hundreds of frames; the axes box is fixed so that the marker scale is the same in every frame."""
+hundreds of frames; the axes box is fixed so that the raster is the same in every frame."""
 
 from __future__ import annotations
 
@@ -18,18 +25,25 @@ matplotlib.use("Agg")  # headless: the solver runs on machines without a display
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from scipy.ndimage import correlate1d
 
 from .atomic import atomic_write_bytes
 
 MELT_LEVEL = 0.5  # liquid fraction drawn as the melt outline
-_MAX_CONTOUR_CELLS = 400  # per axis; bounds the melt-outline grid if points fly far apart
+MATERIAL_LEVEL = 0.5  # area fraction drawn as material: the outline of a regular lattice
+# Half-width of the tent that spreads a point, in point spacings. At 3 the strip of a coalescing
+# pair (its points 2 spacings apart across it) reads 2/3 and is filled, a gap of 3 spacings
+# (0.44) stays open, and a flat free surface keeps its level 1/2 half a spacing out.
+FOOTPRINT_SPACINGS = 3.0
+MIN_MARKER_PT2 = 0.5  # a stray point's marker never shrinks below visibility
+_MAX_RASTER_PIXELS = 1200  # per axis; bounds the raster at a high dpi
 DEFORM_LABELS = {
     "displacement": ("|u| [um]", "displacement"),
     "plastic_strain": ("equivalent plastic strain", "plastic strain"),
 }
 
 
-def _point_spacing(x: np.ndarray, fallback: float) -> float:
+def point_spacing(x: np.ndarray, fallback: float) -> float:
     """Typical particle spacing sqrt(area per point), from a sample of local point densities.
 
     Counting neighbours within a few nearest-neighbour distances (rather than using the
@@ -73,33 +87,63 @@ def _finite_range(
     return vmin, vmax
 
 
-def _melt_grid(
-    x: np.ndarray, lf: np.ndarray, h: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Bin liquid fraction on a grid of cell ``h``; empty cells count as solid (0).
-
-    Contouring this grid at 0.5 is robust for any point set (no triangulation that could fail
-    on collinear/duplicate points or bridge gaps between particles), and cheap (bincount).
-    Returns (xc, yc, values) or None when there is no liquid/solid boundary to draw.
-    """
+def material_raster(
+    x: np.ndarray,
+    values: list[np.ndarray],
+    spacing: float,
+    lo: tuple[float, float],
+    shape: tuple[int, int],
+    pixel: float,
+) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The points as material on a raster of ``shape`` (ny, nx) pixels of side ``pixel`` from
+    corner ``lo``: the area fraction (points of area ``spacing``^2 spread over a tent of
+    half-width FOOTPRINT_SPACINGS spacings) and each of ``values`` as the area-weighted mean of
+    the points nearby (NaN where none has a finite value)."""
+    ny, nx = shape
     ok = np.isfinite(x).all(axis=1)
-    x, lf = x[ok], np.nan_to_num(lf[ok], nan=0.0)
-    if len(x) == 0 or not (lf > MELT_LEVEL).any():
-        return None
-    lo, hi = x.min(axis=0), x.max(axis=0)
-    h = max(h, float((hi - lo).max()) / _MAX_CONTOUR_CELLS, 1e-12)
-    lo = lo - 1.5 * h  # one empty ring all round closes the outline at free surfaces
-    nx, ny = (np.floor((hi - lo) / h).astype(int) + 3).tolist()
-    ij = np.floor((x - lo) / h).astype(int)
-    flat = ij[:, 1] * nx + ij[:, 0]
-    s = np.bincount(flat, weights=lf, minlength=nx * ny)
-    c = np.bincount(flat, minlength=nx * ny)
-    vals = np.divide(s, c, out=np.zeros_like(s), where=c > 0).reshape(ny, nx)
-    if not (vals < MELT_LEVEL).any():
-        return None
-    xc = lo[0] + (np.arange(nx) + 0.5) * h
-    yc = lo[1] + (np.arange(ny) + 0.5) * h
-    return xc, yc, vals
+    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64) if ok.any() else None
+    inside = (
+        np.zeros(0, dtype=bool)
+        if ij is None
+        else ((ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny))
+    )
+    flat = np.zeros(0, dtype=np.int64) if ij is None else ij[inside, 1] * nx + ij[inside, 0]
+    half = int(FOOTPRINT_SPACINGS * spacing / pixel)
+    taps = 1.0 - np.abs(np.arange(-half, half + 1)) * pixel / (FOOTPRINT_SPACINGS * spacing)
+    taps /= taps.sum()  # discrete normalisation: a uniform lattice reads exactly 1
+
+    def spread(weights: np.ndarray) -> np.ndarray:
+        binned = np.bincount(flat, weights=weights, minlength=nx * ny).astype(float)  # int if empty
+        binned = binned.reshape(ny, nx)
+        return correlate1d(
+            correlate1d(binned, taps, axis=0, mode="constant"), taps, axis=1, mode="constant"
+        )
+
+    area = spacing * spacing
+    fraction = spread(np.full(flat.size, area)) / (pixel * pixel)
+    out = []
+    for v in values:
+        v = np.asarray(v, dtype=float)[ok][inside]
+        good = np.isfinite(v)
+        num = spread(np.where(good, v * area, 0.0))
+        den = spread(np.where(good, area, 0.0))
+        out.append(np.divide(num, den, out=np.full_like(num, np.nan), where=den > 0.0))
+    return fraction, out
+
+
+def _on_material(
+    x: np.ndarray, material: np.ndarray, lo: tuple[float, float], pixel: float
+) -> np.ndarray:
+    """Which points lie on a material pixel (non-finite points and those off the raster: no)."""
+    ny, nx = material.shape
+    out = np.zeros(len(x), dtype=bool)
+    ok = np.isfinite(x).all(axis=1)
+    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64)
+    inside = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+    hit = np.zeros(len(ij), dtype=bool)
+    hit[inside] = material[ij[inside, 1], ij[inside, 0]]
+    out[ok] = hit
+    return out
 
 
 def save_png(fig: Figure, path: Path, dpi: int) -> None:
@@ -112,11 +156,16 @@ class FramePainter:
     """Draws one frame into a reused figure of two panels (temperature, deformation)."""
 
     def __init__(
-        self, domain_um: tuple[float, float, float, float], melt_C: float, deformation: str
+        self,
+        domain_um: tuple[float, float, float, float],
+        melt_C: float,
+        deformation: str,
+        dpi: int = 80,
     ) -> None:
         self.domain_um = domain_um
         self.melt_C = melt_C
         self.deformation = deformation
+        self.dpi = dpi  # the raster's pixel is one pixel of the saved image
         self._fig: Figure | None = None
 
     def _setup_figure(self) -> None:
@@ -125,12 +174,26 @@ class FramePainter:
         panel_h = min(max(panel_w * (ymax - ymin) / (xmax - xmin), 1.5), 6.0)
         fig = Figure(figsize=(2 * panel_w + 1.4, panel_h + 1.0))
         FigureCanvasAgg(fig)
-        # Fixed layout (not constrained) so the axes box -- and so the marker scale -- is known
-        # before drawing and identical across frames.
+        # Fixed layout (not constrained) so the axes box -- and so the raster -- is known before
+        # drawing and identical across frames.
         fig.subplots_adjust(left=0.06, right=0.93, bottom=0.14, top=0.86, wspace=0.38)
         axes = fig.subplots(1, 2)
+        # Image pixels per micrometre under equal aspect: the tighter of the two directions.
+        pos = axes[0].get_position()
+        w_in, h_in = fig.get_figwidth() * pos.width, fig.get_figheight() * pos.height
+        px_per_um = self.dpi * min(w_in / (xmax - xmin), h_in / (ymax - ymin))
+        self._pt_per_um = px_per_um * 72.0 / self.dpi  # marker sizes are in points
+        self._pixel = max(1.0 / px_per_um, max(xmax - xmin, ymax - ymin) / _MAX_RASTER_PIXELS)
+        nx = max(1, math.ceil((xmax - xmin) / self._pixel))
+        ny = max(1, math.ceil((ymax - ymin) / self._pixel))
+        self._shape = (ny, nx)
+        self._pixel_centres = (
+            xmin + (np.arange(nx) + 0.5) * self._pixel,
+            ymin + (np.arange(ny) + 0.5) * self._pixel,
+        )
+        extent = (xmin, xmin + nx * self._pixel, ymin, ymin + ny * self._pixel)
         cb_label, name = DEFORM_LABELS[self.deformation]
-        self._scatters, self._cbars = [], []
+        self._images, self._strays, self._cbars = [], [], []
         for ax, cmap, label, title in zip(
             axes,
             ("inferno", "viridis"),
@@ -138,21 +201,25 @@ class FramePainter:
             ("temperature (cyan: melt)", name),
             strict=True,
         ):
-            sc = ax.scatter(
-                np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", linewidths=0
+            im = ax.imshow(
+                np.ma.masked_all(self._shape),
+                cmap=cmap,
+                origin="lower",
+                extent=extent,
+                interpolation="nearest",  # one raster pixel per image pixel already
             )
-            self._cbars.append(fig.colorbar(sc, ax=ax, label=label, fraction=0.046, pad=0.03))
-            self._scatters.append(sc)
+            self._cbars.append(fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03))
+            self._images.append(im)
+            # points too isolated to make material (a lone point, one thrown off) stay visible
+            self._strays.append(
+                ax.scatter(np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", lw=0)
+            )
             ax.set_xlim(xmin, xmax)
             ax.set_ylim(ymin, ymax)
             ax.set_aspect("equal", adjustable="box")
             ax.set_xlabel("x [um]")
             ax.set_ylabel("y [um]")
             ax.set_title(title, fontsize=10)
-        # Points per micrometre under equal aspect: the tighter of the two directions.
-        pos = axes[0].get_position()
-        w_pt, h_pt = fig.get_figwidth() * pos.width * 72, fig.get_figheight() * pos.height * 72
-        self._pt_per_um = min(w_pt / (xmax - xmin), h_pt / (ymax - ymin))
         self._axes, self._contour, self._fig = axes, None, fig
 
     def draw(self, t_s: float, x: np.ndarray, fields: dict[str, np.ndarray]) -> None:
@@ -160,30 +227,41 @@ class FramePainter:
             self._setup_figure()
         fallback = (
             self.domain_um[1] - self.domain_um[0]
-        ) / 100  # lone or coincident points: a small visible square
-        h = _point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
-        # Square side 1.5 h so neighbouring markers overlap: reads as a continuous body.
-        size = max((1.5 * h * self._pt_per_um) ** 2, 0.5)
+        ) / 100  # lone or coincident points: a small visible patch
+        h = point_spacing(x[np.isfinite(x).all(axis=1)], fallback)
         T, d = fields["T_C"], fields["deform"]
+        lf = np.nan_to_num(np.asarray(fields["liquid_fraction"], dtype=float), nan=0.0)
+        fraction, (T_px, d_px, lf_px) = material_raster(
+            x, [T, d, lf], h, (self.domain_um[0], self.domain_um[2]), self._shape, self._pixel
+        )
+        material = fraction >= MATERIAL_LEVEL
         # T range always includes melt_C and |u| starts at 0, so colours keep their meaning.
         limits = (_finite_range(T, hi=self.melt_C), _finite_range(d, lo=0.0))
-        for sc, v, clim in zip(self._scatters, (T, d), limits, strict=True):
-            sc.set_offsets(x)
-            sc.set_array(v)
+        stray = ~_on_material(x, material, (self.domain_um[0], self.domain_um[2]), self._pixel)
+        size = max((h * self._pt_per_um) ** 2, MIN_MARKER_PT2)  # the point's own footprint
+        for im, sc, v, p, clim in zip(
+            self._images, self._strays, (T_px, d_px), (T, d), limits, strict=True
+        ):
+            im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
+            im.set_clim(*clim)
+            sc.set_offsets(x[stray])
+            sc.set_array(np.asarray(p, dtype=float)[stray])
             sc.set_sizes(np.array([size]))
             sc.set_clim(*clim)
         if self._contour is not None:
             with contextlib.suppress(Exception):
                 self._contour.remove()
             self._contour = None
-        try:
-            grid = _melt_grid(x, fields["liquid_fraction"], 2.0 * h)
-            if grid is not None:
+        # The melt outline on the same raster, the void counting as solid: the outline closes
+        # along the free surface and, like the material, has no gap along the mid-plane strip.
+        melt = np.where(material, np.nan_to_num(lf_px, nan=0.0), 0.0)
+        if (melt > MELT_LEVEL).any():
+            try:
                 self._contour = self._axes[0].contour(
-                    *grid, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
+                    *self._pixel_centres, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
                 )
-        except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame to it
-            self._contour = None
+            except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
+                self._contour = None
         self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
 
     def save(self, path: Path, dpi: int) -> None:

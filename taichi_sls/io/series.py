@@ -86,8 +86,12 @@ class SeriesWriter:
                 self._lines = rows[1:]
 
 
+LOG_AXIS_DECADES = 2  # times spanning more decades than this are plotted on a log axis
+
+
 def plot_series(csv_path: Path, png_path: Path, columns: list[str]) -> bool:
-    """Plot each of ``columns`` (those present) against ``t_s`` in microseconds, one panel each.
+    """Plot each of ``columns`` (those present) against ``t_s`` in microseconds, one panel each,
+    on a log axis when the times span more than LOG_AXIS_DECADES decades.
 
     Returns False (and writes nothing) when there is nothing to plot: fewer than two rows, no
     ``t_s`` column or none of ``columns`` present. Unparseable cells plot as gaps.
@@ -109,10 +113,17 @@ def plot_series(csv_path: Path, png_path: Path, columns: list[str]) -> bool:
         return out
 
     t_us = col("t_s") * 1e6
+    pos = t_us[np.isfinite(t_us) & (t_us > 0)]
+    # log-spaced rows (a laser case) span decades: a linear axis would squeeze the transient
+    log_axis = pos.size > 1 and pos.max() / pos.min() > 10.0**LOG_AXIS_DECADES
     fig = Figure(figsize=(4.2 * len(present), 3.2), layout="constrained")
     FigureCanvasAgg(fig)
     for ax, name in zip(fig.subplots(1, len(present), squeeze=False)[0], present, strict=True):
-        ax.plot(t_us, col(name), lw=1.2)
+        if log_axis:
+            keep = t_us > 0  # t = 0 has no place on a log axis
+            ax.semilogx(t_us[keep], col(name)[keep], lw=1.2, marker=".", ms=3)
+        else:
+            ax.plot(t_us, col(name), lw=1.2)
         ax.set_xlabel("t [us]")
         ax.set_ylabel(SERIES_LABELS.get(name, name))
         ax.grid(True, alpha=0.3)

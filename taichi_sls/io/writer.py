@@ -48,7 +48,9 @@ class OutputWriter:
         (self.out_dir / "frames").mkdir(exist_ok=True)
         self._png_paths: dict[int, Path] = {}
         self.series = SeriesWriter(self.out_dir / "timeseries.csv")
-        self._painter = FramePainter((xmin, xmax, ymin, ymax), float(melt_C), deformation)
+        self._painter = FramePainter(
+            (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi
+        )
         self._vtu = VtuWriter(self.out_dir)
 
     # ----------------------------------------------------------------- simple files

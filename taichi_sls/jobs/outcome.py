@@ -4,9 +4,10 @@ and at the end; how long the points stayed above T_m; and the verdict ``fused`` 
 The rule (``[fusion]``): the pair is fused when the neck region -- the points within
 ``neck_region_cells`` cells of the mid-plane between bodies 0 and 1 at the start -- melted
 through (``melted_through`` of its points were fully molten at some time) and the final neck
-(contact line) exceeds the initial one by ``neck_growth``. The verdict needs a solidified end
-state; a run that ends molten, or fails, has ``fused = null``. Every input of the rule is in the
-summary, so that a user can apply another one."""
+(contact line) exceeds the initial one by ``neck_growth``. The verdict needs a laser that heated
+and a solidified end state; a case without a laser, or a run that ends molten or fails, has
+``fused = null`` and says why in ``no_verdict``. Every input of the rule is in the summary, so
+that a user can apply another one."""
 
 from __future__ import annotations
 
@@ -53,6 +54,14 @@ def neck_region(case: Case, x0: np.ndarray, body: np.ndarray, mass: np.ndarray) 
     return (np.abs(x0[:, 0] - mid) <= half) & ((body == 0) | (body == 1))
 
 
+def laser_acted(case: Case) -> bool:
+    """Whether a laser put heat into the case: the verdict asks whether a laser setting fused the
+    pair, so a case without one (an isothermal coalescence) gets none."""
+    return case.physics.thermal and any(
+        las.power_W * las.absorptivity > 0.0 and las.off_s > las.on_s for las in case.lasers
+    )
+
+
 def outcome(
     case: Case,
     history: NeckHistory,
@@ -68,14 +77,20 @@ def outcome(
     melted = float(np.mean(time_molten[in_neck] > 0.0)) if in_neck.any() else 0.0
     growth = neck_end / neck0 - 1.0 if neck0 and math.isfinite(neck0) else math.nan
     fused = None
-    if solidified:
+    no_verdict = None
+    if not laser_acted(case):
+        no_verdict = "no laser in this case"
+    elif not solidified:
+        no_verdict = "not solidified"
+    else:
         fused = bool(melted >= f.melted_through and growth >= f.neck_growth)
     return {
         "fused": fused,
+        "no_verdict": no_verdict,
         "rule": (
             f"neck region melted through (>= {f.melted_through:g} of its points above T_m at "
             f"some time) and final neck >= (1 + {f.neck_growth:g}) x initial neck; needs a "
-            "solidified end state"
+            "solidified end state and a laser that heated"
         ),
         "solidified": solidified,
         "neck_initial_um": neck0,
@@ -99,7 +114,9 @@ def outcome(
 
 def describe(o: dict[str, Any]) -> str:
     """The outcome as lines for the run's printout."""
-    verdict = {True: "FUSED", False: "NOT FUSED", None: "undecided (not solidified)"}[o["fused"]]
+    verdict = {True: "FUSED", False: "NOT FUSED"}.get(
+        o["fused"], f"no verdict ({o.get('no_verdict') or 'not solidified'})"
+    )
 
     def um(v: float | None) -> str:
         return "-" if v is None or not math.isfinite(v) else f"{v:.2f} um"

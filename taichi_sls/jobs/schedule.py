@@ -1,6 +1,10 @@
 """When a run writes its frames and checks whether to stop: linear over ``time.end_s`` or
 log-spaced from ``output.first_frame_s`` (the fusion outcome spans microseconds to tenths of a
-second), and the stop rule of ``time.stop``."""
+second), and the stop rule of ``time.stop``.
+
+A laser case that does not set ``output.frames`` is log-spaced even to a fixed ``end_s``: the
+pair is molten within 20 us and its neck set within 0.1 ms, so 20 linear frames over 1 ms would
+put the whole transient between the first two frames and rows."""
 
 from __future__ import annotations
 
@@ -8,12 +12,17 @@ import math
 from collections.abc import Iterator
 
 from ..config import Case
+from .outcome import laser_acted
+
+DEFAULT_LINEAR_FRAMES = 20  # linear spacing when output.frames is not set
 
 
 def uses_log_spacing(case: Case) -> bool:
+    """``output.spacing``; auto: log for a run to solidification, or for a case a laser heats
+    unless it asks for a number of linear frames."""
     o = case.output
     if o.spacing == "auto":
-        return case.time.stop == "solidified"
+        return case.time.stop == "solidified" or (o.frames is None and laser_acted(case))
     return o.spacing == "log"
 
 
@@ -26,8 +35,9 @@ def frame_steps(case: Case, dt: float) -> Iterator[int]:
     for stop = "solidified" (the run may stop before)."""
     t = case.time
     if not uses_log_spacing(case):
-        per = max(1, math.ceil(t.end_s / case.output.frames / dt - 1e-9))
-        yield from (per * k for k in range(1, case.output.frames + 1))
+        frames = case.output.frames or DEFAULT_LINEAR_FRAMES
+        per = max(1, math.ceil(t.end_s / frames / dt - 1e-9))
+        yield from (per * k for k in range(1, frames + 1))
         return
     end = t.max_s if t.stop == "solidified" else t.end_s
     o = case.output

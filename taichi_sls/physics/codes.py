@@ -43,7 +43,7 @@ class NodeFlag(IntFlag):
 class StressReading(IntEnum):
     """``solver.stress_reading``."""
 
-    MODEL = 0  # s = 2 mu dev(eps_e), p = K tr(eps_e) (MODEL.md)
+    MODEL = 0  # s = 2 mu dev(eps_e), p = K tr(eps_e) (docs/model.md)
     PAPER = 1  # eq. 39 and p = lambda tr(eps) as printed
 
 

@@ -1,8 +1,8 @@
-"""Strain split and the Perzyna elasto-viscoplastic return map (paper eqs. 34-45, MODEL.md).
+"""Strain split and the Perzyna elasto-viscoplastic return map (paper eqs. 34-45, docs/model.md).
 
 Plane strain: the in-plane total strain is accumulated from the velocity gradient
 (eqs. 16-17, eps_zz = 0); plastic, thermal and transformation strains are full 3x3 tensors.
-Readings of MODEL.md: s_trial = 2 mu dev(eps_e) (eq. 39 lost its 2 mu on the trace term) and
+Readings of docs/model.md: s_trial = 2 mu dev(eps_e) (eq. 39 lost its 2 mu on the trace term) and
 p = K tr(eps_e), K = lambda + 2 mu / 3, with eps_e = eps - eps_pl - (eps_th + eps_m).
 
 Finite strain (``solver.strain = "finite"``, :func:`hencky_update`): F = Fe Fp; the elastic
@@ -44,7 +44,7 @@ def embed3(e2):
 
 @ti.func
 def moduli(mp: ti.template(), xi):
-    """(E, nu) of material ``mp`` at solid fraction xi: each interpolated in xi (MODEL.md)."""
+    """(E, nu) of material ``mp`` at solid fraction xi: each interpolated in xi (docs/model.md)."""
     E = lerp_phase(xi, mp.youngs_solid_Pa, mp.youngs_liquid_Pa)
     nu = lerp_phase(xi, mp.poisson, mp.poisson_liquid)
     return E, nu
@@ -64,7 +64,7 @@ def perzyna_update(
     reading: ti.template(),
 ):
     """One backward-Euler Perzyna step of material ``mp``. Returns (sigma, eps_pl, alpha).
-    ``reading``: MODEL.md's stress or the printed eq. 39 and pressure (StressReading).
+    ``reading``: docs/model.md's stress or the printed eq. 39 and pressure (StressReading).
 
     Trial: s_tr = 2 mu dev(eps_e), f = |s_tr| - sqrt(2/3)(sigma_Y + H alpha) (eq. 40); when f > 0,
     dgamma = (f / 2mu) / (tau/dt + 1 + H/(3 mu)), tau = eta / (2 mu) (eq. 41), and the plastic

@@ -2,7 +2,7 @@
 (``surface_tension.method = "csf"``).
 
 The force (eq. 19): f_i = V_c gamma kappa_i grad m_i / [m] * m_i / <m> with [m] = rho V_c and
-<m> = [m] / 2 (MODEL.md), grad m_i from eq. 20 with the uGIMP gradient at node positions. The
+<m> = [m] / 2 (docs/model.md), grad m_i from eq. 20 with the uGIMP gradient at node positions. The
 ghost nodes beyond the walls enter grad m only. Level set: physics/level_set.py; curvature:
 physics/curvature.py.
 """
@@ -46,7 +46,7 @@ def mass_gradient(cfg: ti.template(), box: ti.template(), nd: ti.template()):
 
 @ti.func
 def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: ti.template(), t):
-    """Eq. 19 with [m] = rho V_c and <m> = rho V_c / 2 (MODEL.md).
+    """Eq. 19 with [m] = rho V_c and <m> = rho V_c / 2 (docs/model.md).
 
     Surface tension on a closed surface has no resultant, but the discrete CSF force keeps a
     small one from the curvature's noise (0.3 % of |f| on a disc of points, enough to set it

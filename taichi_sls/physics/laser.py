@@ -1,4 +1,4 @@
-"""The Gaussian laser of eq. 31 (MODEL.md reading: power per unit volume, Beer-Lambert decay
+"""The Gaussian laser of eq. 31 (docs/model.md reading: power per unit volume, Beer-Lambert decay
 with depth below the top of the powder).
 
 Each beam is one element of a struct field whose members are in SI (the case's ``_um`` keys in

@@ -5,7 +5,7 @@ file's key names, in SI: a key in C (``melt_C``) becomes the same name in kelvin
 every other key keeps its name and unit (``youngs_solid_Pa``). Three members are derived:
 ``enthalpy_reference_K`` (``thermal.enthalpy_reference_C``) and the enthalpies at T_c and T_m.
 
-Enthalpy per unit mass (MODEL.md: an enthalpy update per point, T recovered from H):
+Enthalpy per unit mass (docs/model.md: an enthalpy update per point, T recovered from H):
     H(T) = int_{T_ref}^T c(T') dT' + l_s (1 - xi_s(T)),
 with c = xi_s c_c + (1 - xi_s) c_m and xi_s of eq. 33 clamped to [0, 1]. Between T_c and T_m the
 sensible part is quadratic in T (c varies linearly), so the inverse T(H) is closed form.

@@ -4,9 +4,9 @@ Per heat step: heat capacity c_i = sum M_p c_p N_ip (eq. 28, with c_p the appare
 dH/dT, so the grid update already sees the latent heat) and the capacity-weighted node
 temperature; the point temperature gradient grad T_p = sum T_i grad N_ip; the heat rate
 Q_i = - sum V_p k_p grad T_p . grad N_ip + sum V_p s_laser N_ip (eq. 29 with the weak-form minus
-sign of MODEL.md, eq. 30's laser term with eq. 31 read as W/m^3); dT_i = dt Q_i / c_i; each point
-gains enthalpy dH_p = c_p sum N_ip dT_i. Since sum_p M_p c_p N_ip / c_i = 1 this moves exactly the
-grid's heat to the points: the energy balance holds to round-off.
+sign of docs/model.md, eq. 30's laser term with eq. 31 read as W/m^3); dT_i = dt Q_i / c_i; each
+point gains enthalpy dH_p = c_p sum N_ip dT_i. Since sum_p M_p c_p N_ip / c_i = 1 this moves exactly
+the grid's heat to the points: the energy balance holds to round-off.
 
 Sub-grid filter (``thermal.subgrid_filter``, chi per heat step): the grid sees a point's
 temperature only through the capacity-weighted node average, so increments alone (FLIP) never
@@ -23,7 +23,7 @@ order.
 Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
 increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
-(MODEL.md: resetting the nodes by increments drove points beside the plate to 110 C).
+(docs/model.md: resetting the nodes by increments drove points beside the plate to 110 C).
 
 Arguments: ``cfg`` the step's configuration, ``pt`` points, ``nd`` nodes, ``mat`` materials,
 ``sc`` the run's scalars (heat out through the walls' nodes), ``lasers`` the beams. The point
@@ -167,9 +167,9 @@ def g2p_heat(
     Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
     transfer). A point within the support of a fixed node takes the interpolated grid temperature
     sum N T_i^{n+1} instead (T_i = the wall temperature there): a convex combination of node
-    temperatures, so it can never pass the wall temperature (MODEL.md), and second-order accurate
-    next to the wall where increments alone would lag. What that changes in its enthalpy beyond
-    the FLIP increment is heat exchanged with the wall and is booked in heat_out.
+    temperatures, so it can never pass the wall temperature (docs/model.md), and second-order
+    accurate next to the wall where increments alone would lag. What that changes in its enthalpy
+    beyond the FLIP increment is heat exchanged with the wall and is booked in heat_out.
     """
     dTg = 0.0
     T_pic = 0.0

@@ -56,7 +56,7 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
     for las in case.lasers:
         r0 = las.spot_radius_um * 1e-6
         eta = las.penetration_depth_um * 1e-6
-        # eq. 31 read as power per unit volume (W/m^3), MODEL.md
+        # eq. 31 read as power per unit volume (W/m^3), docs/model.md
         amp = 2 * las.absorptivity * las.power_W / (math.pi * r0 * r0 * eta) * las.depth_factor
         if las.source_units == "W_per_kg":  # eq. 3 as printed: rho * s_laser
             amp *= case.materials[case.bodies[0].material].density_kg_m3
@@ -97,7 +97,7 @@ def p_wave_modulus(E: float, nu: float) -> float:
 
 
 def stability_limits(m: Material, h: float) -> dict[str, float]:
-    """Time-step limits (s) of one material on grid spacing h (m), MODEL.md / eqs. 46-48.
+    """Time-step limits (s) of one material on grid spacing h (m), docs/model.md / eqs. 46-48.
 
     The elastic limit uses the larger P-wave modulus of the two phases, each with its own nu;
     the thermal limit the smallest heat capacity and largest conductivity; a solvent

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
+from taichi_sls.io.frames import MATERIAL_LEVEL, material_raster
 from taichi_sls.io.series import plot_series
 from taichi_sls.io.writer import OutputWriter
 
@@ -193,3 +194,54 @@ def test_gif_size_limit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None
     gif = tmp_path / "animation.gif"
     assert gif.stat().st_size <= 60_000
     assert 2 <= iio.imread(gif, index=None).shape[0] < 12
+
+
+def test_material_raster_closes_the_mid_plane_strip_and_keeps_the_outline() -> None:
+    """Two coalescing bodies keep an empty strip along their symmetry line (their points two
+    spacings apart across it): drawn as material it must not read as a crack, while a real gap
+    stays open and the drawn area is the points' own."""
+    d, pixel = 1.0, 0.25
+    g = np.arange(0.0, 40.0) + 0.5
+    xx, yy = np.meshgrid(g, g)
+    block = np.column_stack([xx.ravel(), yy.ravel()])  # a 40 x 40 um square of points
+    shape = (200, 240)  # 50 x 60 um of pixels from the corner (-5, -5)
+
+    def fraction(gap: int) -> np.ndarray:
+        """The raster of the block with ``gap`` columns emptied at x = 20 um."""
+        keep = np.abs(block[:, 0] - 20.5) >= gap / 2
+        f, (u,) = material_raster(block[keep], [block[keep, 0]], d, (-5.0, -5.0), shape, pixel)
+        assert np.nanmax(u[f >= MATERIAL_LEVEL]) <= 40.0  # values are means of the points'
+        return f
+
+    row = (20.0 + 5.0) / pixel  # the pixel row across the middle of the block
+    f = fraction(1)  # points 2 spacings apart across the strip
+    assert f[int(row), int((20.5 + 5.0) / pixel)] >= MATERIAL_LEVEL
+    middle = f[:, int((20.5 + 5.0) / pixel)]
+    # no dash along the 40 um of the strip; only its ends, at the free surface, notch by ~d
+    assert (middle >= MATERIAL_LEVEL).sum() * pixel >= 40.0 - 2 * d
+    f = fraction(4)  # a real crack of 4 spacings stays open
+    assert f[int(row), int((20.5 + 5.0) / pixel)] < MATERIAL_LEVEL
+    # the outline of the full block on its true edge, half a spacing beyond the last points
+    f = fraction(0)
+    assert (f >= MATERIAL_LEVEL).sum() * pixel**2 == pytest.approx(40.0 * 40.0, rel=0.02)
+
+
+def test_outcome_plot_fills_the_final_shape_under_the_initial_outline(tmp_path: Path) -> None:
+    """outcome.png: the final material filled in one colour, each body's initial outline a line
+    in another, so the two shapes can be told apart (pale dots of both could not)."""
+    from matplotlib.colors import to_rgb
+
+    from taichi_sls.io.outcome_plot import FINAL_COLOUR, INITIAL_COLOUR, plot_outcome
+
+    (tmp_path / "timeseries.csv").write_text(
+        "t_s,contact_line_um,molten_fraction\n0,8,0\n1e-5,10,0.5\n1e-3,12,0.9\n"
+    )
+    x = two_discs()
+    body = (x[:, 0] > 40.0).astype(int)
+    final = x + np.where(body == 0, 1.0, -1.0)[:, None] * [1.0, 0.0]  # the pair moved together
+    path = plot_outcome(tmp_path, x * 1e-6, final * 1e-6, body)
+    assert path is not None
+    im = iio.imread(path)[..., :3].astype(int)
+    for colour in (FINAL_COLOUR, INITIAL_COLOUR):
+        rgb = np.round(np.array(to_rgb(colour)) * 255)
+        assert (np.abs(im - rgb).sum(axis=-1) < 30).sum() > 200, colour

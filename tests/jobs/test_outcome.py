@@ -9,7 +9,7 @@ import pytest
 from helpers import PAPER_SCENE, deep_update, make_case
 
 from taichi_sls.jobs.case_run import run_case
-from taichi_sls.jobs.outcome import NeckHistory, outcome
+from taichi_sls.jobs.outcome import NeckHistory, describe, outcome
 from taichi_sls.jobs.schedule import frame_steps, settled
 
 
@@ -36,6 +36,23 @@ def test_log_frames_hit_1ms_and_stop_at_max_time():
     assert len(steps) == 46  # 10 per decade from 1 us to 30 ms, plus the end
 
 
+def test_a_laser_case_to_1ms_shows_its_transient_frame_by_frame():
+    """The pair melts within 20 us and its neck is set within 0.1 ms: a laser case's frames are
+    log-spaced by default, with 1 ms the last; spacing = "linear" or a number of frames keeps
+    the old linear frames."""
+    dt = 5e-8
+    laser = {"lasers": [{"power_W": 25.0}], "time": {"end_s": 1e-3}}
+    t = np.array(list(frame_steps(_case(laser), dt))) * dt
+    assert len(t) == 31 and t[-1] == pytest.approx(1e-3)  # 10 per decade from 1 us
+    assert np.sum(t <= 2e-5) >= 13 and np.sum(t <= 1e-4) >= 20
+    linear = deep_update(laser, {"output": {"spacing": "linear"}})
+    t = np.array(list(frame_steps(_case(linear), dt))) * dt
+    assert len(t) == 20 and t[0] == pytest.approx(5e-5)
+    # a case that asks for a number of frames keeps them linear under spacing = auto
+    t = np.array(list(frame_steps(_case(deep_update(laser, {"output": {"frames": 4}})), dt)))
+    assert len(t) == 4 and t[-1] * dt == pytest.approx(1e-3)
+
+
 def test_settled_needs_lasers_off_solid_and_quiet():
     case = _case({"lasers": [{"power_W": 25.0, "off_s": 2e-5}], "time": {"stop": "solidified"}})
     quiet = {"molten_fraction": 0.0, "T_max_C": 145.0, "kinetic_ratio": 1e-9}
@@ -52,8 +69,11 @@ def _history(necks, molten, times):
     return h
 
 
+LASER = {"lasers": [{"power_W": 25.0}]}
+
+
 def test_verdict_follows_its_rule():
-    case = _case({})
+    case = _case(LASER)
     h = _history([8.0, 8.5, 9.0, 9.0], [0.0, 0.9, 0.0, 0.0], [0.0, 1e-3, 2e-2, 5e-2])
     final = {"contact_line_um": 9.0, "T_peak_C": 300.0}
     in_neck = np.array([True, True, False])
@@ -70,6 +90,40 @@ def test_verdict_follows_its_rule():
     # grew less than the margin
     small = {"contact_line_um": 8.2, "T_peak_C": 300.0}
     assert outcome(case, h, small, melted, in_neck, solidified=True)["fused"] is False
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        {},  # no [[lasers]] at all
+        {"lasers": [{"power_W": 0.0}]},
+        {**LASER, "physics": {"thermal": False}},  # an isothermal run: the beam heats nothing
+    ],
+)
+def test_no_verdict_without_a_laser(extra):
+    """A pair that coalesces with no laser (Hopper's isothermal discs) is neither fused nor not
+    fused by a laser: the verdict is null and the summary and printout say why."""
+    h = _history([8.0, 12.0], [0.0, 0.0], [0.0, 1e-3])
+    o = outcome(
+        _case(extra),
+        h,
+        {"contact_line_um": 12.0, "T_peak_C": 140.0},
+        np.array([1e-3, 1e-3]),
+        np.array([True, True]),
+        solidified=True,
+    )
+    assert o["fused"] is None and o["no_verdict"] == "no laser in this case"
+    assert describe(o).startswith("outcome: no verdict (no laser in this case)")
+    assert "NOT FUSED" not in describe(o)
+    with_laser = outcome(
+        _case(LASER),
+        h,
+        {"contact_line_um": 12.0, "T_peak_C": 300.0},
+        np.array([1e-3, 1e-3]),
+        np.array([True, True]),
+        solidified=True,
+    )
+    assert with_laser["fused"] is True and with_laser["no_verdict"] is None
 
 
 # a run to solidification in seconds: coarse grid, the inertia scaled so that the step is the
