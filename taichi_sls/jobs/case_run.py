@@ -26,6 +26,7 @@ from ..solver.simulation import Simulation
 from .outcome import NeckHistory, describe, neck_region, outcome
 from .progress import Progress
 from .schedule import frame_steps, settled
+from .unheated import needs_baseline, unheated_neck_um
 
 # statuses: complete (end_s reached, or solidified and settled), max_time (stop = solidified
 # gave up at time.max_s), failed (the guard), interrupted (Ctrl-C, SIGTERM)
@@ -69,6 +70,14 @@ def run_case(
     (a study's initial fields and time-dependent load)."""
     out_dir = Path(out_dir)
     wall0 = time.perf_counter()
+    baseline_um = None
+    if needs_baseline(case) and scene is None:
+        print(
+            f"{case.case.name}: the unheated baseline ({case.fusion.baseline_s:g} s without "
+            "laser heat)",
+            file=sys.stderr,
+        )
+        baseline_um = unheated_neck_um(case)
     sim = Simulation(case, scene=scene, before_step=before_step)
     sc = sim.scene
     writer = _writer(case, out_dir)
@@ -182,6 +191,7 @@ def run_case(
             pt.time_molten.to_numpy(),
             in_neck,
             solidified=solid and summary["status"] == "complete",
+            baseline_um=baseline_um,
         )
         if summary["status"] == "max_time":
             warnings.append(

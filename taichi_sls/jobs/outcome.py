@@ -4,7 +4,10 @@ and at the end; how long the points stayed above T_m; and the verdict ``fused`` 
 The rule (``[fusion]``): the pair is fused when the neck region -- the points within
 ``neck_region_cells`` cells of the mid-plane between bodies 0 and 1 at the start -- melted
 through (``melted_through`` of its points were fully molten at some time) and the final neck
-(contact line) exceeds the initial one by ``neck_growth``. The verdict needs a laser that heated
+(contact line) exceeds the baseline neck by ``neck_growth``. The baseline (``fusion.baseline``)
+is the neck the same pair reaches unheated (jobs/unheated.py: a soft solid with a surface
+energy adheres and grows its contact without any laser), or the initial neck; the summary gives
+both, and the growth against each. The verdict needs a laser that heated
 and a solidified end state; a case without a laser, or a run that ends molten or fails, has
 ``fused = null`` and says why in ``no_verdict``. Every input of the rule is in the summary, so
 that a user can apply another one."""
@@ -69,31 +72,42 @@ def outcome(
     time_molten: np.ndarray,
     in_neck: np.ndarray,
     solidified: bool,
+    baseline_um: float | None = None,
 ) -> dict[str, Any]:
-    """The outcome record of the summary (lengths in um, times in s)."""
+    """The outcome record of the summary (lengths in um, times in s). ``baseline_um``: the
+    unheated run's neck (jobs/unheated.py), when one was made."""
     f = case.fusion
     neck0 = history.initial if history.initial is not None else math.nan
     neck_end = final["contact_line_um"]
     melted = float(np.mean(time_molten[in_neck] > 0.0)) if in_neck.any() else 0.0
-    growth = neck_end / neck0 - 1.0 if neck0 and math.isfinite(neck0) else math.nan
+    growth = _growth(neck_end, neck0)
+    unheated = baseline_um if baseline_um is not None else math.nan
+    reference, reference_name = neck0, "initial neck"
+    if f.baseline == "unheated":
+        reference, reference_name = unheated, "unheated neck"
     fused = None
     no_verdict = None
     if not laser_acted(case):
         no_verdict = "no laser in this case"
     elif not solidified:
         no_verdict = "not solidified"
+    elif not math.isfinite(reference):
+        no_verdict = f"no {reference_name} (the unheated run failed)"
     else:
-        fused = bool(melted >= f.melted_through and growth >= f.neck_growth)
+        fused = bool(melted >= f.melted_through and _growth(neck_end, reference) >= f.neck_growth)
     return {
         "fused": fused,
         "no_verdict": no_verdict,
         "rule": (
             f"neck region melted through (>= {f.melted_through:g} of its points above T_m at "
-            f"some time) and final neck >= (1 + {f.neck_growth:g}) x initial neck; needs a "
+            f"some time) and final neck >= (1 + {f.neck_growth:g}) x {reference_name}; needs a "
             "solidified end state and a laser that heated"
         ),
         "solidified": solidified,
+        "baseline": f.baseline,
         "neck_initial_um": neck0,
+        "neck_unheated_um": unheated,
+        "neck_growth_over_unheated": _growth(neck_end, unheated),
         "neck_1ms_um": history.at_1ms,
         "neck_refrozen_um": history.refrozen,
         "refrozen_s": history.refrozen_t,
@@ -112,6 +126,10 @@ def outcome(
     }
 
 
+def _growth(neck: float, reference: float) -> float:
+    return neck / reference - 1.0 if reference and math.isfinite(reference) else math.nan
+
+
 def describe(o: dict[str, Any]) -> str:
     """The outcome as lines for the run's printout."""
     verdict = {True: "FUSED", False: "NOT FUSED"}.get(
@@ -124,7 +142,13 @@ def describe(o: dict[str, Any]) -> str:
     return (
         f"outcome: {verdict}; neck {um(o['neck_initial_um'])} at the start, "
         f"{um(o['neck_1ms_um'])} at 1 ms, {um(o['neck_refrozen_um'])} when refrozen, "
-        f"{um(o['neck_final_um'])} at the end ({o['neck_growth']:+.1%}); neck region melted "
+        f"{um(o['neck_final_um'])} at the end ({o['neck_growth']:+.1%})"
+        + (
+            f", {um(o['neck_unheated_um'])} unheated ({o['neck_growth_over_unheated']:+.1%})"
+            if math.isfinite(o.get("neck_unheated_um", math.nan))
+            else ""
+        )
+        + f"; neck region melted "
         f"{o['neck_region_melted_fraction']:.0%}, peak T {o['T_peak_C']:.1f} C, longest time "
         f"above T_m {o['time_above_melt_s']['max'] * 1e3:.3g} ms\n  rule: {o['rule']}"
     )

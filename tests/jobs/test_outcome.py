@@ -73,7 +73,7 @@ LASER = {"lasers": [{"power_W": 25.0}]}
 
 
 def test_verdict_follows_its_rule():
-    case = _case(LASER)
+    case = _case({**LASER, "fusion": {"baseline": "initial"}})
     h = _history([8.0, 8.5, 9.0, 9.0], [0.0, 0.9, 0.0, 0.0], [0.0, 1e-3, 2e-2, 5e-2])
     final = {"contact_line_um": 9.0, "T_peak_C": 300.0}
     in_neck = np.array([True, True, False])
@@ -90,6 +90,25 @@ def test_verdict_follows_its_rule():
     # grew less than the margin
     small = {"contact_line_um": 8.2, "T_peak_C": 300.0}
     assert outcome(case, h, small, melted, in_neck, solidified=True)["fused"] is False
+
+
+def test_verdict_against_the_unheated_neck():
+    """The default baseline is the neck the same pair reaches unheated: a refrozen neck 12.5 %
+    above the initial one but only 2.3 % above the unheated (adhesion) neck is not fused; the
+    summary gives both growths, and a failed unheated run leaves no verdict."""
+    case = _case(LASER)
+    h = _history([8.0, 8.5, 9.0, 9.0], [0.0, 0.9, 0.0, 0.0], [0.0, 1e-3, 2e-2, 5e-2])
+    final = {"contact_line_um": 9.0, "T_peak_C": 300.0}
+    in_neck, melted = np.array([True, True]), np.array([1e-3, 2e-3])
+    o = outcome(case, h, final, melted, in_neck, solidified=True, baseline_um=8.8)
+    assert o["fused"] is False and o["baseline"] == "unheated"
+    assert o["neck_growth"] == pytest.approx(0.125)
+    assert o["neck_growth_over_unheated"] == pytest.approx(9.0 / 8.8 - 1.0)
+    assert "unheated" in describe(o)
+    o = outcome(case, h, final, melted, in_neck, solidified=True, baseline_um=8.4)
+    assert o["fused"] is True
+    o = outcome(case, h, final, melted, in_neck, solidified=True, baseline_um=float("nan"))
+    assert o["fused"] is None and "unheated" in o["no_verdict"]
 
 
 @pytest.mark.parametrize(
@@ -122,6 +141,7 @@ def test_no_verdict_without_a_laser(extra):
         np.array([1e-3, 1e-3]),
         np.array([True, True]),
         solidified=True,
+        baseline_um=8.0,
     )
     assert with_laser["fused"] is True and with_laser["no_verdict"] is None
 
