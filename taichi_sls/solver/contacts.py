@@ -110,6 +110,8 @@ def neck_width(
     narrowest section; 0 where a section holds no material (a torn neck).
     """
     d = float(np.linalg.norm(cb - ca))
+    if not (math.isfinite(d) and d > 0.0 and math.isfinite(reach)):  # a blown-up state
+        return math.nan, np.full(2, math.nan)
     e = (cb - ca) / d
     n = np.array([-e[1], e[0]])
     step = SECTION_STEP * h

@@ -96,3 +96,11 @@ def test_neck_width_is_the_narrowest_section_and_zero_when_torn():
     assert where == pytest.approx([20.0, 20.0], abs=h / 8)
     torn = np.where(np.abs(X - 20.0) < 1.0, -1.0, field)
     assert neck_width(torn, h, off, np.array([12.0, 20.0]), np.array([28.0, 20.0]), 15.0)[0] == 0
+
+
+def test_neck_width_of_a_blown_up_state_is_nan():
+    """NaN centres (the state the guard reports) give a NaN neck, not an exception, so that the
+    failed run's last frame is still written."""
+    field = np.zeros((10, 10))
+    width, where = neck_width(field, 1.0, 2, np.array([np.nan, 1.0]), np.array([5.0, 1.0]), 3.0)
+    assert math.isnan(width) and np.isnan(where).all()
