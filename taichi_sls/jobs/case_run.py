@@ -146,6 +146,7 @@ def run_case(
     )
     step_wall = 0.0
     steps0 = sim.steps
+    solid = False
     try:
         for k in range(k0 + 1, len(schedule) + 1):
             while sim.steps < schedule[k - 1]:

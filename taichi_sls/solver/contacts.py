@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 
 TOUCH_SPACINGS = 1.5  # two bodies touch where their points lie this many point spacings apart
 SECTION_STEP = 0.125  # sampling of a neck section, in cells (sub-cell: the crossings are linear)
+FAR_APART = 16.0  # centres farther apart than this many body radii: no neck to read
 SECTION_RANGE = 0.25  # sections across the middle half of the centre distance (each side)
 
 
@@ -110,7 +111,8 @@ def neck_width(
     narrowest section; 0 where a section holds no material (a torn neck).
     """
     d = float(np.linalg.norm(cb - ca))
-    if not (math.isfinite(d) and d > 0.0 and math.isfinite(reach)):  # a blown-up state
+    # a blown-up state (the guard reports it): centres NaN, or flung far beyond the bodies' size
+    if not (math.isfinite(d) and math.isfinite(reach) and 0.0 < d <= FAR_APART * reach):
         return math.nan, np.full(2, math.nan)
     e = (cb - ca) / d
     n = np.array([-e[1], e[0]])

@@ -182,7 +182,9 @@ def test_nolaser_neck_holds_and_kinetic_energy_decays():
     """Issue #4's laser-off check with the paper's force (cases/nolaser.toml, 1 ms): the
     contact line stays within 2 % of its start (measured: 8.27 -> 8.27-8.40 um) and the kinetic
     energy does not grow from noise (measured: 3.1e-10 J/m at 0.1 ms, 3.9e-13 J/m at 1 ms)."""
-    sim = Simulation(load_case("nolaser", ["surface_tension.method=csf"]))
+    sim = Simulation(
+        load_case("nolaser", ["surface_tension.method=csf", "contact.neck_section=column"])
+    )
     m0 = sim.monitors()
     lines, ke = neck_and_kinetic_energy(sim, 1e-4, 10)
     assert max(abs(c / m0["contact_line_um"] - 1.0) for c in lines) < 0.02

@@ -136,17 +136,27 @@ def test_colour_contact_line_of_the_paper_pair():
     """The colour interface's contact line of the paper's pair at t = 0 (no r_p): 13.58 um at
     h = 2 um with the colour filter, 9.33 um without (the filter bridges gaps about twice as
     wide; both fall as sqrt(h): touching circles meet in a point, docs/verification.md); the
-    level set of eq. 21 gives the paper's 8.27 um beside it."""
-    cls = []
+    level set of eq. 21 gives the paper's 8.27 um beside it. All on the vertical node column
+    (contact.neck_section = "column"); the section across the centres reads the raw colour,
+    the unfiltered value, whatever the filter."""
+    cls, across = [], []
     for filt in ("true", "false"):
         sim = Simulation(
-            load_case("nolaser", [f"surface_tension.surface_energy_colour_filter={filt}"])
+            load_case(
+                "nolaser",
+                [
+                    f"surface_tension.surface_energy_colour_filter={filt}",
+                    "contact.neck_section=column",
+                ],
+            )
         )
         m = sim.monitors()
         cls.append(m["contact_line_um"])
         assert m["contact_line_level_set_um"] == pytest.approx(8.27, abs=0.01)
+        across.append(sim.necks_m("colour")[0] * 1e6)
     assert cls[0] == pytest.approx(13.58, abs=0.05)
     assert cls[1] == pytest.approx(9.33, abs=0.05)
+    assert across == pytest.approx([9.33, 9.33], abs=0.05)
 
 
 def test_surface_energy_is_the_default_and_csf_stays_reachable():

@@ -104,3 +104,5 @@ def test_neck_width_of_a_blown_up_state_is_nan():
     field = np.zeros((10, 10))
     width, where = neck_width(field, 1.0, 2, np.array([np.nan, 1.0]), np.array([5.0, 1.0]), 3.0)
     assert math.isnan(width) and np.isnan(where).all()
+    far = neck_width(field, 1.0, 2, np.array([0.0, 1.0]), np.array([1e30, 1.0]), 3.0)[0]
+    assert math.isnan(far)
