@@ -108,8 +108,14 @@ def material_raster(
         else ((ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny))
     )
     flat = np.zeros(0, dtype=np.int64) if ij is None else ij[inside, 1] * nx + ij[inside, 0]
-    half = int(FOOTPRINT_SPACINGS * spacing / pixel)
-    taps = 1.0 - np.abs(np.arange(-half, half + 1)) * pixel / (FOOTPRINT_SPACINGS * spacing)
+    # a footprint beyond a tenth of the frame is the spacing of a blown-up state (points flung
+    # apart): capped, the frame still draws in its usual time
+    reach = FOOTPRINT_SPACINGS * spacing
+    half = int(reach / pixel)
+    if half > max(nx, ny) // 10:
+        half = max(nx, ny) // 10
+        reach = (half + 1) * pixel
+    taps = 1.0 - np.abs(np.arange(-half, half + 1)) * pixel / reach
     taps /= taps.sum()  # discrete normalisation: a uniform lattice reads exactly 1
 
     def spread(weights: np.ndarray) -> np.ndarray:
