@@ -11,7 +11,8 @@ from taichi_sls.solver.simulation import Simulation
 
 
 def _neck_um(name: str, h: float, *sets: str) -> float:
-    case = taichi_sls.load_case(name, [f"grid.spacing_um={h}", "solver.optimize=false", *sets])
+    sets = (f"grid.spacing_um={h}", "solver.optimize=false", "contact.neck_section=centres", *sets)
+    case = taichi_sls.load_case(name, list(sets))
     return Simulation(case).monitors()["contact_line_um"]
 
 
