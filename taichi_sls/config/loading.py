@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import copy
 import tomllib
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import tomli_w
 from pydantic import ValidationError
@@ -14,16 +15,36 @@ from pydantic import ValidationError
 from .errors import CaseError, case_error
 from .schema import Case
 
+T = TypeVar("T")
+
 
 def read_toml(path: str | Path, what: str, error: type[Exception] = CaseError) -> dict:
-    """Parse a TOML file, turning a missing file or bad syntax into ``error`` with the path."""
+    """Parse a TOML file, turning a missing, unreadable, binary, non-UTF-8 or empty file, or bad
+    syntax, into one line of ``error`` that names the path."""
     path = Path(path)
     if not path.is_file():
         raise error(f"{what} {str(path)!r} does not exist")
     try:
-        return tomllib.loads(path.read_text())
+        raw = path.read_bytes()
+    except OSError as e:
+        raise error(f"{what} {str(path)!r}: cannot be read ({e.strerror or e})") from None
+    if b"\0" in raw:  # UTF-8 text never holds a NUL byte: an image, an archive, a .npz ...
+        raise error(f"{path}: a binary file, not TOML text; a {what} is UTF-8 text")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise error(
+            f"{path}: not UTF-8 text (byte 0x{raw[e.start]:02x} on line {line}); save the "
+            f"{what} as UTF-8"
+        ) from None
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise error(f"{path}: not valid TOML: {e}") from None
+    if not data:  # blank or comments only: say so, not what the first missing key would be
+        raise error(f"{path}: the {what} is empty (no key and no table)")
+    return data
 
 
 def deep_update(base: dict, extra: dict) -> dict:
@@ -106,7 +127,16 @@ def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
     if "case" not in data or "name" not in data.get("case", {}):
         data.setdefault("case", {})["name"] = path.stem
     resolve_files(data, path.parent)
-    return case_from_dict(data)
+    return in_file(path, case_from_dict, data)
+
+
+def in_file(path: Path, build: Callable[[dict], T], data: dict) -> T:
+    """``build(data)``, its CaseError prefixed with the file the data came from (the line
+    then names the file as well as the key)."""
+    try:
+        return build(data)
+    except CaseError as e:
+        raise CaseError(f"{path}: {e}") from None
 
 
 def case_to_dict(case: Case) -> dict:

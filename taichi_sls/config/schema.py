@@ -35,9 +35,12 @@ MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this mac
 __all__ = ["Body", "Case", "Disc", "Material", "MAX_CELLS", "Pair"]
 
 
+NO_BODIES = "at least one [[bodies]] table is required"
+
+
 def _not_empty(v: list) -> list:
     if not v:
-        raise ValueError("at least one [[bodies]] table is required")
+        raise ValueError(NO_BODIES)
     return v
 
 
@@ -62,6 +65,9 @@ class Case(Model):
     @classmethod
     def _default_shape(cls, data: Any) -> Any:
         """A body without ``shape`` is a disc (the discriminator needs the tag)."""
+        if isinstance(data, dict) and "bodies" not in data:
+            # the default [] is not validated: say here what --set bodies=[] says
+            raise CaseError(f"bodies: missing; {NO_BODIES}")
         if isinstance(data, dict) and isinstance(data.get("bodies"), list):
             data = dict(data)
             data["bodies"] = [

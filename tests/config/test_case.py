@@ -145,3 +145,62 @@ def test_cli_reports_bad_case_without_traceback(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "bodies[0].radius_um = -3: must be > 0" in err
     assert not (tmp_path / "o").exists()
+
+
+# a file that is not a case: its bytes, and what the one line must say besides the file name
+BAD_FILES = [
+    (b"", "the case file is empty"),
+    (b"# a comment only\n\n", "the case file is empty"),
+    (b'[case]\nname = "x"\n[grid]\nspacing_um = 2.0\n', "bodies: missing; at least one [[bodies]]"),
+    ('[case]\nname = "café"\n'.encode("latin-1"), "not UTF-8 text (byte 0xe9 on line 2)"),
+    (b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", "a binary file, not TOML text"),
+    (b"[grid\nspacing_um = 2", "not valid TOML"),
+]
+BAD_IDS = ["empty", "comments_only", "no_bodies", "latin1", "binary", "toml_syntax"]
+
+
+@pytest.mark.parametrize("content, says", BAD_FILES, ids=BAD_IDS)
+def test_bad_case_file_is_one_error_naming_the_file(tmp_path, content, says):
+    p = tmp_path / "bad.toml"
+    p.write_bytes(content)
+    with pytest.raises(CaseError) as err:
+        load_case(p)
+    msg = str(err.value)
+    assert msg.startswith(f"{p}: ") and says in msg and "\n" not in msg
+
+
+def test_no_bodies_reads_like_the_override():
+    """A file without [[bodies]] and --set bodies=[] say the same thing about the same key."""
+    no_table = {k: v for k, v in PAPER_SCENE.items() if k != "bodies"}
+    with pytest.raises(CaseError, match=r"^bodies: missing; at least one \[\[bodies\]\] table"):
+        case_from_dict(no_table)
+    with pytest.raises(CaseError, match=r"power25W\.toml: bodies = \[\]: at least one \[\[bodies"):
+        load_case("power25W", ["bodies=[]"])
+
+
+def test_validation_error_names_the_file(tmp_path):
+    p = tmp_path / "c.toml"
+    p.write_text("[[bodies]]\nradius_um = -3\n")
+    with pytest.raises(CaseError, match=r"c\.toml: bodies\[0\]\.radius_um = -3: must be > 0"):
+        load_case(p)
+
+
+@pytest.mark.parametrize("content, says", BAD_FILES, ids=BAD_IDS)
+def test_cli_bad_case_file_is_one_line(tmp_path, capsys, content, says):
+    from taichi_sls.cli import main, run_main
+
+    p = tmp_path / "bad.toml"
+    p.write_bytes(content)
+    for run in (run_main, lambda a: main(["run", *a])):
+        assert run([str(p), "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"error: {p}: ") and says in err[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_cli_missing_file_is_one_line(tmp_path, capsys):
+    from taichi_sls.cli import run_main
+
+    assert run_main([str(tmp_path / "nope.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: case file {str(tmp_path / 'nope.toml')!r} does not exist"]

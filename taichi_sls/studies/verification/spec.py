@@ -22,7 +22,7 @@ from pydantic import Field, ValidationError
 
 from ...config import Case, CaseError, bundled_cases, case_from_dict, deep_update, read_toml
 from ...config.errors import case_error
-from ...config.loading import bundled_root, find_case, resolve_files
+from ...config.loading import bundled_root, find_case, in_file, resolve_files
 from ...config.model import Model, Pair
 from .. import references as ref
 from .geometry import bar_geometry, disc_geometry, hopper_geometry, slab_length
@@ -174,7 +174,7 @@ def load_file(path: str | Path, overrides: list[str] | None = None) -> Verificat
         apply_override(data, o)
     data.setdefault("case", {}).setdefault("name", path.stem)
     resolve_files(data, path.parent)
-    return from_dict(data)
+    return in_file(path, from_dict, data)
 
 
 # ------------------------------------------------------------------------------ resolution

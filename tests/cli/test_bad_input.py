@@ -1,0 +1,37 @@
+"""The command lines themselves, as a user starts them: a bad case file ends with one line and
+exit status 2, never a traceback."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(
+    "module, content, says",
+    [
+        (["taichi_sls.run"], b"", "the case file is empty"),
+        (["taichi_sls", "run"], b"\xff\xfe[\x00c\x00", "a binary file"),
+        (["taichi_sls.run"], "x = 'é'".encode("latin-1"), "not UTF-8 text"),
+    ],
+    ids=["empty", "utf16_binary", "latin1"],
+)
+def test_python_m_bad_file_one_line(tmp_path, module, content, says):
+    p = tmp_path / "bad.toml"
+    p.write_bytes(content)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    r = subprocess.run(
+        [sys.executable, "-m", *module, str(p), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 2, r.stderr
+    assert len(lines) == 1 and lines[0].startswith(f"error: {p}: ") and says in lines[0]
+    assert "Traceback" not in r.stderr and r.stdout == ""
