@@ -6,6 +6,7 @@ wall-clock limit, crash -- leaves each output either old or complete, never trun
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,12 @@ from .gif import write_gif
 from .series import MONITORED, SeriesWriter, plot_series
 from .summary import write_summary
 from .vtu import VtuWriter
+
+# the drawn deformation in a VTU written without the full point data: named for what it is
+VTU_DEFORM_NAMES = {
+    "displacement": "displacement_magnitude_um",
+    "plastic_strain": "equivalent_plastic_strain",
+}
 
 
 class OutputWriter:
@@ -42,6 +49,7 @@ class OutputWriter:
             raise ValueError(f"domain_um={domain_um!r} must be (xmin, xmax, ymin, ymax), min<max")
         self.out_dir = Path(out_dir)
         self.png, self.gif, self.vtu = png, gif, vtu
+        self.deformation = deformation
         self.dpi = int(dpi)
         self.frames_written = 0
         self.out_dir.mkdir(parents=True, exist_ok=True)
@@ -86,8 +94,13 @@ class OutputWriter:
         T_C: np.ndarray,
         deform: np.ndarray,
         liquid_fraction: np.ndarray,
+        point_data: Mapping[str, np.ndarray] | None = None,
     ) -> None:
-        """Write frame ``index`` (PNG and/or VTU as configured) for time ``t_s`` seconds."""
+        """Write frame ``index`` (PNG and/or VTU as configured) for time ``t_s`` seconds.
+
+        ``deform`` is the drawn deformation (``deformation``); ``point_data`` the VTU's further
+        fields (:func:`taichi_sls.io.vtu.point_data`). Without it the VTU carries ``deform``
+        under the name of what it is."""
         x = np.asarray(x_um, dtype=float).reshape(-1, 2)
         fields = {
             "T_C": np.asarray(T_C, dtype=float).ravel(),
@@ -104,7 +117,11 @@ class OutputWriter:
             self._painter.save(path, self.dpi)
             self._png_paths[index] = path
         if self.vtu:
-            self._vtu.write(index, float(t_s), x, fields)
+            extra = point_data
+            if extra is None:
+                extra = {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
+            vtu = {"T_C": fields["T_C"], "liquid_fraction": fields["liquid_fraction"], **extra}
+            self._vtu.write(index, float(t_s), x, vtu)
         self.frames_written += 1
 
     # ----------------------------------------------------------------- end of run

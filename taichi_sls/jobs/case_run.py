@@ -19,6 +19,7 @@ from typing import Any
 
 from ..config import Case, case_to_toml
 from ..io.outcome_plot import plot_outcome
+from ..io.vtu import point_data
 from ..io.writer import OutputWriter
 from ..solver.guard import SimulationError
 from ..solver.scene import Scene
@@ -49,6 +50,18 @@ def _writer(case: Case, out_dir: Path) -> OutputWriter:
         vtu=o.vtu,
         dpi=o.dpi,
         deformation=o.deformation,
+    )
+
+
+def vtu_point_data(snap: dict[str, Any]) -> dict[str, Any]:
+    """The VTU fields of a full :meth:`Simulation.snapshot`."""
+    return point_data(
+        body_id=snap["body_id"],
+        velocity_m_s=snap["velocity_m_s"],
+        displacement_um=snap["displacement_vector_um"],
+        stress_Pa=snap["stress_Pa"],
+        equivalent_plastic_strain=snap["plastic_strain"],
+        J=snap["J"],
     )
 
 
@@ -114,11 +127,14 @@ def run_case(
         mon = sim.monitors(guard=guard)
         writer.row(mon)
         history.add(mon)
-        snap = sim.snapshot()
+        snap = sim.snapshot(full=writer.vtu)
         deform = snap[
             "displacement_um" if case.output.deformation == "displacement" else "plastic_strain"
         ]
-        writer.frame(index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"])
+        extra = vtu_point_data(snap) if writer.vtu else None
+        writer.frame(
+            index, sim.t, snap["x_um"], snap["T_C"], deform, snap["liquid_fraction"], extra
+        )
         return mon
 
     k0 = 0

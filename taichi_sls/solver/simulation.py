@@ -298,13 +298,26 @@ class Simulation:
         self.dt = float(self.state.scalars.dt[None])
         return extra
 
-    def snapshot(self) -> dict[str, np.ndarray]:
+    def snapshot(self, full: bool = False) -> dict[str, np.ndarray]:
+        """The points for output: position (um), T_C, displacement magnitude (um), equivalent
+        plastic strain, liquid fraction; ``full`` adds what the VTU holds besides (read only
+        then: the stress alone is 9 numbers a point): body_id, velocity_m_s (N, 2),
+        displacement_vector_um (N, 2), stress_Pa (N, 3, 3; the material's Cauchy stress, not
+        the melt's solvent stress, which is a force term only) and J."""
         pt = self.state.points
         x = pt.x.to_numpy()
-        return {
+        u = x - pt.x0.to_numpy()
+        snap = {
             "x_um": x * 1e6,
             "T_C": pt.T.to_numpy() - KELVIN,
-            "displacement_um": np.linalg.norm(x - pt.x0.to_numpy(), axis=1) * 1e6,
+            "displacement_um": np.linalg.norm(u, axis=1) * 1e6,
             "plastic_strain": pt.equivalent_plastic_strain.to_numpy(),
             "liquid_fraction": 1.0 - pt.solid_fraction.to_numpy(),
         }
+        if full:  # the scene's body index follows the points when the blocks layout sorts them
+            snap["body_id"] = np.asarray(self.scene.body, dtype=np.int32)
+            snap["velocity_m_s"] = pt.v.to_numpy()
+            snap["displacement_vector_um"] = u * 1e6
+            snap["stress_Pa"] = pt.stress.to_numpy()
+            snap["J"] = pt.J.to_numpy()
+        return snap

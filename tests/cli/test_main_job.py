@@ -52,6 +52,18 @@ def test_main_job_writes_every_output(tmp_path):
     assert abs(s["simulated_s"] - 2e-5) < 1e-6
     mesh = meshio.read(sorted((out / "vtu").glob("*.vtu"))[-1])
     assert len(mesh.points) == 632 and "T_C" in mesh.point_data
+    pd = mesh.point_data
+    for name in ("velocity_m_s", "von_mises_Pa", "pressure_Pa", "equivalent_plastic_strain"):
+        assert len(pd[name]) == 632 and np.isfinite(pd[name]).all(), name
+    assert sorted(np.unique(pd["body_id"])) == [0, 1]  # the two discs
+    left = pd["body_id"] == 0
+    assert mesh.points[left, 0].max() < mesh.points[~left, 0].min() + 4.0  # disc 0 on the left
+    assert 0.9 < pd["J"].min() and pd["J"].max() < 1.1
+    assert pd["velocity_m_s"].shape == (632, 3) and np.abs(pd["velocity_m_s"][:, :2]).max() > 0
+    # the Laplace pressure of the discs and the heated melt: stressed, the invariants consistent
+    assert pd["von_mises_Pa"].max() > 0 and (pd["von_mises_Pa"] >= 0).all()
+    mean = (pd["stress_xx_Pa"] + pd["stress_yy_Pa"] + pd["stress_zz_Pa"]) / 3
+    np.testing.assert_allclose(pd["pressure_Pa"], -mean, atol=1e-6 * np.abs(mean).max())
 
 
 def test_single_precision_runs():

@@ -16,6 +16,7 @@ import pytest
 from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
 from taichi_sls.io.frames import MATERIAL_LEVEL, material_raster
 from taichi_sls.io.series import plot_series
+from taichi_sls.io.vtu import VtuWriter, point_data, stress_invariants
 from taichi_sls.io.writer import OutputWriter
 
 DOMAIN = (0.0, 80.0, 0.0, 48.0)
@@ -87,9 +88,12 @@ def test_full_run(writer: OutputWriter) -> None:
     assert files == [f"vtu/points_{i:04d}.vtu" for i in range(3)]
     assert times == [0.0, 25e-6, 50e-6]
     mesh = meshio.read(out / files[1])
-    x, T, _, _ = synthetic(1)
+    x, T, u, _ = synthetic(1)
     assert mesh.points.shape == (len(x), 3)
     np.testing.assert_allclose(mesh.point_data["T_C"], T)
+    # without the solver's point data the drawn deformation is named for what it is
+    assert set(mesh.point_data) == {"T_C", "liquid_fraction", "displacement_magnitude_um"}
+    np.testing.assert_allclose(mesh.point_data["displacement_magnitude_um"], u)
     assert not list(out.rglob(".*.tmp"))
 
 
@@ -245,3 +249,103 @@ def test_outcome_plot_fills_the_final_shape_under_the_initial_outline(tmp_path: 
     for colour in (FINAL_COLOUR, INITIAL_COLOUR):
         rgb = np.round(np.array(to_rgb(colour)) * 255)
         assert (np.abs(im - rgb).sum(axis=-1) < 30).sum() > 200, colour
+
+
+def solver_point_data(x: np.ndarray) -> dict[str, np.ndarray]:
+    """Point data as a run hands it over: body by side, a velocity, a stress with every
+    component distinct, plastic strain and J."""
+    n = len(x)
+    stress = np.zeros((n, 3, 3))
+    stress[:, 0, 0], stress[:, 1, 1], stress[:, 2, 2] = -3e5, 1e5, 2e4
+    stress[:, 0, 1] = stress[:, 1, 0] = 5e4 * np.arange(n) / n
+    return point_data(
+        body_id=(x[:, 0] > 40.0).astype(np.int64),
+        velocity_m_s=np.column_stack([np.full(n, 0.25), -x[:, 1] * 1e-3]),
+        displacement_um=np.column_stack([x[:, 0] * 1e-2, np.zeros(n)]),
+        stress_Pa=stress,
+        equivalent_plastic_strain=np.linspace(0.0, 0.1, n),
+        J=np.full(n, 0.98),
+    )
+
+
+VTU_FIELDS = {  # name: components in the file
+    "T_C": 1,
+    "liquid_fraction": 1,
+    "body_id": 1,
+    "velocity_m_s": 3,
+    "displacement_um": 3,
+    "stress_xx_Pa": 1,
+    "stress_yy_Pa": 1,
+    "stress_zz_Pa": 1,
+    "stress_xy_Pa": 1,
+    "von_mises_Pa": 1,
+    "pressure_Pa": 1,
+    "equivalent_plastic_strain": 1,
+    "J": 1,
+}
+
+
+def test_vtu_point_data_is_complete_and_valid(tmp_path: Path) -> None:
+    x, T, u, lf = synthetic(1)
+    extra = solver_point_data(x)
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, png=False, gif=False, vtu=True)
+    w.frame(0, 0.0, x, T, u, lf, extra)
+    path = tmp_path / "vtu" / "points_0000.vtu"
+
+    # the XML as ParaView reads it: one Piece of N points; every point array named once, with
+    # its components declared and its type (body_id an integer)
+    root = ET.parse(path).getroot()
+    assert root.get("type") == "UnstructuredGrid"
+    piece = root.find("UnstructuredGrid/Piece")
+    assert piece is not None and int(piece.get("NumberOfPoints")) == len(x)
+    arrays = {a.get("Name"): a for a in piece.find("PointData").iter("DataArray")}
+    assert set(arrays) == set(VTU_FIELDS)
+    for name, k in VTU_FIELDS.items():
+        assert int(arrays[name].get("NumberOfComponents", "1")) == k, name
+    assert arrays["body_id"].get("type").startswith("Int")
+    assert arrays["von_mises_Pa"].get("type") == "Float64"
+
+    # every array holds one tuple per point, with the values given
+    mesh = meshio.read(path)
+    for name, k in VTU_FIELDS.items():
+        v = mesh.point_data[name]
+        assert v.shape == ((len(x),) if k == 1 else (len(x), k)), name
+    np.testing.assert_array_equal(mesh.point_data["body_id"], (x[:, 0] > 40.0).astype(int))
+    np.testing.assert_allclose(mesh.point_data["velocity_m_s"][:, 1], -x[:, 1] * 1e-3)
+    assert not mesh.point_data["velocity_m_s"][:, 2].any()  # in plane: z = 0
+    np.testing.assert_allclose(mesh.point_data["stress_xy_Pa"], extra["stress_xy_Pa"])
+    np.testing.assert_allclose(mesh.point_data["stress_zz_Pa"], 2e4)
+    np.testing.assert_allclose(mesh.point_data["pressure_Pa"], (3e5 - 1e5 - 2e4) / 3)
+    np.testing.assert_allclose(mesh.point_data["J"], 0.98)
+
+
+def test_stress_invariants_of_known_states() -> None:
+    s = 2e5
+    states = np.zeros((4, 3, 3))
+    states[0, 0, 0] = s  # uniaxial tension
+    states[1] = -s * np.eye(3)  # hydrostatic compression
+    states[2, 0, 1] = states[2, 1, 0] = s  # pure shear
+    states[3] = np.diag([s, s, 0.0])  # equibiaxial
+    vm, p = stress_invariants(states)
+    np.testing.assert_allclose(vm, [s, 0.0, np.sqrt(3.0) * s, s], atol=1e-9 * s)
+    np.testing.assert_allclose(p, [-s / 3, s, 0.0, -2 * s / 3], atol=1e-9 * s)
+
+
+def test_point_data_of_no_points(tmp_path: Path) -> None:
+    """A frame with no point left (all flown off the grid) still writes every field."""
+    data = solver_point_data(np.zeros((0, 2)))
+    assert set(data) == set(VTU_FIELDS) - {"T_C", "liquid_fraction"}
+    assert data["velocity_m_s"].shape == (0, 3) and data["von_mises_Pa"].shape == (0,)
+    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, png=False, gif=False, vtu=True)
+    w.frame(0, 0.0, np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0), data)
+    names = {
+        a.get("Name") for a in ET.parse(tmp_path / "vtu" / "points_0000.vtu").iter("DataArray")
+    }
+    assert set(VTU_FIELDS) <= names
+
+
+def test_vtu_refuses_an_array_of_the_wrong_length(tmp_path: Path) -> None:
+    x = two_discs()
+    with pytest.raises(ValueError, match="J has 3 tuples"):
+        VtuWriter(tmp_path).write(0, 0.0, x, {"T_C": np.zeros(len(x)), "J": np.ones(3)})
+    assert not (tmp_path / "vtu" / "points_0000.vtu").exists()

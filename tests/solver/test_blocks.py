@@ -22,6 +22,7 @@ def _run(
     pt = sim.state.points
     order = np.lexsort(pt.x0.to_numpy().T)  # the blocks layout sorts the points
     out = {k: getattr(pt, k).to_numpy()[order] for k in ("x", "v", "T", "stress")}
+    out["body_id"] = sim.snapshot(full=True)["body_id"][order]  # the VTU's, after any sort
     # read now: the next Simulation re-initialises Taichi and frees these fields
     sorts = sim.blocks.sorts if sim.blocks is not None else 0
     return sim.monitors(), sorts, sim.blocks is not None and sim.blocks.n_blocks, out
@@ -56,3 +57,6 @@ def test_points_are_sorted_again_when_they_drift():
     _, sorts, _, b = _run("blocks", extra=wide, shift=20e-6)
     assert sorts > 0
     np.testing.assert_allclose(b["x"], a["x"], rtol=0, atol=1e-9 * np.abs(a["x"]).max())
+    # each point's body follows it through the sorts (the VTU's body_id)
+    assert sorted(set(a["body_id"])) == [0, 1]
+    np.testing.assert_array_equal(b["body_id"], a["body_id"])
