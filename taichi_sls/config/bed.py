@@ -65,7 +65,10 @@ class Bed(Model):
     )
     seed: int = Field(0, ge=0, description="seed of the random generator: same seed, same bed")
     x_range_um: Pair | None = Field(
-        None, description="[x0, x1] the discs are deposited over (um); default the domain width"
+        None,
+        description="[x0, x1] the discs are deposited over, side walls at its ends (um); "
+        "default the domain width. Without domain.width_um (or height_um) the domain is sized "
+        "to the bed: x1 wide, the bed's top plus one mean diameter high, in whole cells",
     )
     material: str = Field("PA12", description="material of the discs")
     temperature_C: float | None = Field(
@@ -236,6 +239,11 @@ def bed_discs(
         lo, hi = 0.0, float(np.max(x + r))
     if not hi > lo:
         raise CaseError(f"bed.x_range_um = {[lo, hi]}: x1 must exceed x0")
+    if lo < 0 or (width_um is not None and hi > width_um):
+        raise CaseError(
+            f"bed.x_range_um = {[lo, hi]}: must lie within the domain, x from 0 to "
+            f"domain.width_um = {width_um}"
+        )
     n = bed.count
     if bed.layers is not None:
         n = max(1, round(bed.layers * (hi - lo) / bed.median_diameter_um))

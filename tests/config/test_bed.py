@@ -93,6 +93,15 @@ def test_lognormal_median_and_spread():
     assert np.all(np.abs(np.log(d / 50.0)) <= 0.9 + 1e-12)
 
 
+def test_sizes_drawn_from_a_csv_of_measured_diameters(tmp_path):
+    (tmp_path / "sizes.csv").write_text("diameter_um\n38.5\n51.0\n# a comment\n62.25\n")
+    case = _case(
+        {"count": 12, "sizes_csv": str(tmp_path / "sizes.csv"), "x_range_um": [0.0, 300.0]}
+    )
+    diameters = {2 * b.radius_um for b in case.bodies}
+    assert diameters <= {38.5, 51.0, 62.25} and len(diameters) > 1
+
+
 def test_area_in_window_of_a_clipped_disc():
     # a unit disc cut through its centre by the window's edge: half its area
     a = area_in_window(np.array([0.0]), np.array([0.0]), np.array([1.0]), (0.0, 5.0), (-5, 5))
@@ -226,6 +235,7 @@ BED_BAD = [
     ({"count": 5, "spread": 2.0}, "bed.spread"),
     ({"csv": "no/such.csv"}, "bed.csv"),
     ({"count": 5, "x_range_um": [50.0, 10.0]}, "bed.x_range_um"),
+    ({"count": 5, "x_range_um": [0.0, 150.0]}, "must lie within the domain"),
 ]
 
 
