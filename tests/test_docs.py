@@ -26,7 +26,7 @@ def _keys(text: str) -> set[str]:
 
 
 def _known(section: str, key: str) -> bool:
-    from taichi_sls.config import Disc, Material, Polygon, Rect
+    from taichi_sls.config import Bed, Disc, Material, Polygon, Rect
     from taichi_sls.config.sections import Laser, Wall
 
     ann = Case.model_fields[section].annotation
@@ -35,6 +35,7 @@ def _known(section: str, key: str) -> bool:
         "materials": (Material,),
         "lasers": (Laser,),
         "boundary": (Wall,),
+        "bed": (Bed,),
     }.get(section, (ann,))
     if section == "boundary" and key in ("left", "right", "bottom", "top"):
         return True

@@ -1,6 +1,7 @@
 """Case files: the validated schema, TOML loading with ``--set`` overrides, and the generated
 key reference. The lowest layer: it imports nothing else of the package."""
 
+from .bed import Bed
 from .bodies import Body, Disc, Polygon, Rect
 from .errors import CaseError
 from .loading import (
@@ -18,6 +19,7 @@ from .materials import Material
 from .schema import Case
 
 __all__ = [
+    "Bed",
     "Body",
     "Case",
     "CaseError",

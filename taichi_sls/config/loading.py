@@ -110,11 +110,15 @@ def case_from_dict(data: dict) -> Case:
 
 
 def resolve_files(data: dict, folder: Path) -> None:
-    """Body files named relative to the case file, made absolute."""
-    for b in data.get("bodies", []) if isinstance(data.get("bodies"), list) else []:
-        f = b.get("vertices_file") if isinstance(b, dict) else None
+    """Body and bed files named relative to the case file, made absolute."""
+    tables = data.get("bodies", []) if isinstance(data.get("bodies"), list) else []
+    keys = [(b, "vertices_file") for b in tables if isinstance(b, dict)]
+    if isinstance(data.get("bed"), dict):
+        keys += [(data["bed"], "csv"), (data["bed"], "sizes_csv")]
+    for table, key in keys:
+        f = table.get(key)
         if isinstance(f, str) and not Path(f).is_absolute():
-            b["vertices_file"] = str((folder / f).resolve())
+            table[key] = str((folder / f).resolve())
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:

@@ -8,6 +8,7 @@ import typing
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
+from .bed import Bed
 from .bodies import Disc, Polygon, Rect
 from .materials import Material
 from .schema import Case
@@ -23,6 +24,8 @@ def sections() -> list[tuple[str, type[BaseModel]]]:
                 (f'[[bodies]] shape = "{b.model_fields["shape"].annotation.__args__[0]}"', b)
                 for b in (Disc, Rect, Polygon)
             ]
+        elif name == "bed":
+            out.append(("bed", Bed))
         elif name == "materials":
             out.append(("materials.NAME", Material))
         elif name == "boundary":

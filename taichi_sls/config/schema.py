@@ -7,10 +7,13 @@ solver converts to SI (m, K) when it builds its fields. Every check runs here, b
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+import math
+from typing import Any
 
-from pydantic import AfterValidator, Field, model_validator
+import numpy as np
+from pydantic import Field, PrivateAttr, model_validator
 
+from .bed import Bed, bed_discs
 from .bodies import Body, Disc
 from .errors import CaseError
 from .materials import Material
@@ -32,23 +35,18 @@ from .surface import SurfaceTension
 
 MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
 
-__all__ = ["Body", "Case", "Disc", "Material", "MAX_CELLS", "Pair"]
+__all__ = ["Bed", "Body", "Case", "Disc", "Material", "MAX_CELLS", "Pair"]
 
 
-NO_BODIES = "at least one [[bodies]] table is required"
-
-
-def _not_empty(v: list) -> list:
-    if not v:
-        raise ValueError(NO_BODIES)
-    return v
+NO_BODIES = "at least one [[bodies]] table or a [bed] table is required"
 
 
 class Case(Model):
     case: CaseInfo = Field(default_factory=CaseInfo)
     grid: Grid = Field(default_factory=Grid)
     domain: Domain = Field(default_factory=Domain)
-    bodies: Annotated[list[Body], AfterValidator(_not_empty)] = Field(default_factory=list)
+    bodies: list[Body] = Field(default_factory=list)
+    bed: Bed | None = None
     materials: dict[str, Material] = Field(default_factory=lambda: {"PA12": Material()})
     boundary: Boundary = Field(default_factory=Boundary)
     physics: Physics = Field(default_factory=Physics)
@@ -60,12 +58,14 @@ class Case(Model):
     output: Output = Field(default_factory=Output)
     fusion: Fusion = Field(default_factory=Fusion)
     contact: Contact = Field(default_factory=Contact)
+    # what the [bed] was (source, disc count, packing fractions) once its discs are bodies
+    _bed_report: dict | None = PrivateAttr(None)
 
     @model_validator(mode="before")
     @classmethod
     def _default_shape(cls, data: Any) -> Any:
         """A body without ``shape`` is a disc (the discriminator needs the tag)."""
-        if isinstance(data, dict) and "bodies" not in data:
+        if isinstance(data, dict) and "bodies" not in data and "bed" not in data:
             # the default [] is not validated: say here what --set bodies=[] says
             raise CaseError(f"bodies: missing; {NO_BODIES}")
         if isinstance(data, dict) and isinstance(data.get("bodies"), list):
@@ -76,9 +76,57 @@ class Case(Model):
             ]
         return data
 
+    def _expand_bed(self) -> None:
+        """The [bed]'s discs become bodies after the [[bodies]], and the table goes (the resolved
+        case lists the discs, so it loads back to the same bed). An unset domain width or height
+        is fitted to the bed: its x range, and its top plus one mean diameter, in whole cells."""
+        bed = self.bed
+        if bed is None:
+            return
+        if bed.material not in self.materials:
+            raise CaseError(
+                f"bed.material = {bed.material!r}: no such material; defined: "
+                f"{', '.join(self.materials)}"
+            )
+        given = self.domain.model_fields_set
+        W = self.domain.width_um if "width_um" in given else None
+        H = self.domain.height_um if "height_um" in given else None
+        old = [[*b.center_um, b.radius_um] for b in self.bodies if b.shape == "disc"]
+        join = 2.0 * self.contact.fillet_radius_um if self.contact.initial == "fillet" else 0.0
+        discs = bed_discs(bed, np.array(old, dtype=float).reshape(-1, 3), W, H, join)
+        h = self.grid.spacing_um
+        if W is None:
+            right = max(discs.report["x_range_um"][1], float(np.max(discs.x + discs.r)))
+            self.domain.width_um = h * math.ceil(right / h - 1e-9)
+        if H is None:
+            top = float(np.max(discs.y + discs.r)) + 2.0 * float(np.mean(discs.r))
+            self.domain.height_um = h * math.ceil(top / h - 1e-9)
+        self.bodies = [
+            *self.bodies,
+            *(
+                Disc(
+                    center_um=[float(x), float(y)],
+                    radius_um=float(r),
+                    material=bed.material,
+                    temperature_C=bed.temperature_C,
+                )
+                for x, y, r in zip(discs.x, discs.y, discs.r, strict=True)
+            ),
+        ]
+        self.bed = None
+        self._bed_report = discs.report
+
+    def bed_report(self) -> dict | None:
+        """The [bed] this case was built from: source, disc count, packing fractions
+        (envelope, bulk) and mean top height (um); None without a bed."""
+        return self._bed_report
+
     @model_validator(mode="after")
     def _cross_checks(self) -> Case:
         """What a field type alone cannot express."""
+        self._expand_bed()
+        if not self.bodies:
+            raise CaseError(f"bodies: {NO_BODIES}")
         W, Hh = self.domain.width_um, self.domain.height_um
         h = self.grid.spacing_um
         if h > min(W, Hh) / 2:
