@@ -126,7 +126,7 @@ class Case(Model):
         """What a field type alone cannot express."""
         self._expand_bed()
         if not self.bodies:
-            raise CaseError(f"bodies: {NO_BODIES}")
+            raise CaseError(f"bodies = []: {NO_BODIES}")
         W, Hh = self.domain.width_um, self.domain.height_um
         h = self.grid.spacing_um
         if h > min(W, Hh) / 2:
