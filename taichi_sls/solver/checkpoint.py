@@ -39,9 +39,23 @@ SCALARS = ("t", "dt", "laser_energy", "heat_out", "T_peak")
 NODE_MEMBERS = ("kappa", "flags")
 
 
-def save(st: State, path: Path, steps: int, case_name: str, extra: dict | None = None) -> None:
-    """The points, scalars and kept node fields, atomically; ``extra`` numbers alongside."""
+def save(
+    st: State,
+    path: Path,
+    steps: int,
+    case_name: str,
+    extra: dict | None = None,
+    order: np.ndarray | None = None,
+) -> None:
+    """The points, scalars and kept node fields, atomically; ``extra`` numbers alongside;
+    ``order`` each point's index at the start (the blocks layout sorts them as they flow) and
+    the blocks' ranges of the sorted points."""
     data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in POINT_MEMBERS}
+    if order is not None:
+        data["order"] = np.asarray(order, dtype=np.int64)
+    if st.blocks is not None:
+        data["b_start"] = st.blocks.start.to_numpy()
+        data["b_count"] = st.blocks.count.to_numpy()
     data.update({f"s_{k}": np.array(getattr(st.scalars, k)[None]) for k in SCALARS})
     data.update({f"g_{k}": getattr(st.nodes, k).to_numpy() for k in NODE_MEMBERS})
     data["steps"] = np.array(steps)
@@ -73,6 +87,22 @@ def load(st: State, path: Path, case_name: str) -> tuple[int, dict]:
         getattr(st.scalars, k)[None] = float(z[f"s_{k}"])
     for k in NODE_MEMBERS:
         getattr(st.nodes, k).from_numpy(z[f"g_{k}"])
+    if st.blocks is not None and "b_start" in z.files:
+        st.blocks.start.from_numpy(z["b_start"])
+        st.blocks.count.from_numpy(z["b_count"])
     steps = int(z["steps"])
     st.scalars.step[None] = steps
     return steps, {k[2:]: z[k].item() for k in z.files if k.startswith("x_")}
+
+
+def point_order(path: Path, n_points: int) -> np.ndarray | None:
+    """The points' order a checkpoint was saved in (None for one written before it was kept,
+    or unreadable: :func:`load` says why)."""
+    try:
+        with np.load(path) as z:
+            order = z["order"] if "order" in z.files else None
+    except (OSError, ValueError):
+        return None
+    if order is None or order.shape != (n_points,):
+        return None
+    return order

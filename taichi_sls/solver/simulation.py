@@ -97,6 +97,9 @@ class Simulation:
         advance(self.state, 0)  # compiles the step kernel
         self.compile_s = time.perf_counter() - t0
         self._mass = self.state.points.mass.to_numpy()
+        # each point's index in the order the run started with: the blocks layout sorts the
+        # points again as they flow, and a checkpoint keeps that order
+        self.point_order = np.arange(self.scene.n_points)
         walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
         coldest = min([float(self.scene.T0_C.min()), *walls])
         # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32
@@ -141,14 +144,19 @@ class Simulation:
     def sort_points(self) -> None:
         """Blocks layout: the points sorted by block again (every per-point array and the
         scene's), and the blocks' ranges."""
-        pt = self.state.points
-        x = pt.x.to_numpy()
+        x = self.state.points.x.to_numpy()
         order = self.blocks.order(x)
+        self._permute(order)
+        self.blocks.set_ranges(x[order])
+
+    def _permute(self, order: np.ndarray) -> None:
+        """Every per-point array, the scene's and the host copies, in the order ``order``."""
+        pt = self.state.points
         pt.from_numpy({k: v[order] for k, v in pt.to_numpy().items()})
         self.scene = self.scene.reordered(order)
         self.state.scene = self.scene
         self._mass = self._mass[order]
-        self.blocks.set_ranges(x[order])
+        self.point_order = self.point_order[order]
 
     # ------------------------------------------------------------------ monitors
     def phi(self) -> np.ndarray:
@@ -289,10 +297,15 @@ class Simulation:
     # ------------------------------------------------------------------ state
     def save_checkpoint(self, path: Path, extra: dict | None = None) -> None:
         """The full state, written atomically; ``extra`` (numbers) alongside, e.g. the frame."""
-        checkpoint.save(self.state, path, self.steps, self.case.case.name, extra)
+        checkpoint.save(self.state, path, self.steps, self.case.case.name, extra, self.point_order)
 
     def load_checkpoint(self, path: Path) -> dict:
-        """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``."""
+        """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``. A run whose
+        points were sorted again comes back in its sorted order: the arrays a checkpoint does
+        not hold (mass, volume, material, the scene's) are put in that order first."""
+        saved = checkpoint.point_order(path, self.scene.n_points)
+        if saved is not None and not np.array_equal(saved, self.point_order):
+            self._permute(np.argsort(self.point_order)[saved])
         self.steps, extra = checkpoint.load(self.state, path, self.case.case.name)
         init_box(self.state)
         self.dt = float(self.state.scalars.dt[None])
