@@ -6,7 +6,7 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, Field
 
-from .model import Model
+from .model import Model, Pair
 
 
 def _poisson(v: float) -> float:
@@ -29,7 +29,21 @@ class Material(Model):
     heat_capacity_liquid_J_kgK: float = Field(2700.0, gt=0, description="c_m")
     latent_heat_J_kg: float = Field(50e3, ge=0, description="l_s")
     melt_C: float = Field(175.0, description="T_m")
-    crystallization_C: float = Field(146.0, description="T_c (< T_m)")
+    crystallization_C: float = Field(
+        146.0,
+        description="T_c (< T_m): the melting range is [T_c, T_m], on heating and cooling alike "
+        "(eq. 33); with crystallization_range_C set, on heating only",
+    )
+    crystallization_range_C: Pair | None = Field(
+        None,
+        description="[T_low, T_high] with T_low < T_high <= crystallization_C: thermal "
+        "hysteresis, a melt that supercools. Each point's solid fraction becomes history: it "
+        "melts over [T_c, T_m] on heating, stays as it is while the temperature lies between "
+        "the two ranges, and crystallises over [T_low, T_high] on cooling; the latent heat is "
+        "absorbed on melting and released on crystallisation (docs/model.md). PA12 melts at "
+        "about 175-185 C and crystallises near 145-150 C. Unset: the paper's one range [T_c, "
+        "T_m] both ways",
+    )
     expansion_solid_1_K: float = Field(15e-5, description="alpha for T <= T_c")
     expansion_liquid_1_K: float = Field(5e-5, description="alpha for T >= T_m")
     solidification_dilatation: float = Field(
@@ -70,3 +84,9 @@ class Material(Model):
         "0.01 Pa s for the paper's PA12, five orders below the melt viscosity. Its explicit "
         "limit dt <= rho h^2 / (c eta_s) joins the automatic time step (solver/params.py)",
     )
+
+    def solid_below_C(self) -> float:
+        """The temperature below which the material is solid whatever its history (C): the
+        bottom of the crystallisation range, or T_c without hysteresis."""
+        r = self.crystallization_range_C
+        return self.crystallization_C if r is None else r[0]

@@ -42,8 +42,9 @@ class Time(Model):
     stop: Literal["end", "solidified"] = Field(
         "end",
         description="end: run to end_s; solidified: once every laser is off, run until every "
-        "point is solid (T <= T_c) and the kinetic energy has fallen below "
-        "settled_kinetic_fraction of the surface energy, or to max_s (then marked max_time)",
+        "point is solid (T <= T_c; with crystallization_range_C, crystallised) and the kinetic "
+        "energy has fallen below settled_kinetic_fraction of the surface energy, or to max_s "
+        "(then marked max_time)",
     )
     max_s: float = Field(
         0.5, gt=0, description='simulated time at which a stop = "solidified" run gives up (s)'

@@ -143,6 +143,13 @@ class Case(Model):
                     f"materials.{name}.crystallization_C = {m.crystallization_C}: must be below "
                     f"melt_C = {m.melt_C}"
                 )
+            rng = m.crystallization_range_C
+            if rng is not None and not rng[0] < rng[1] <= m.crystallization_C:
+                raise CaseError(
+                    f"materials.{name}.crystallization_range_C = {rng}: must be [T_low, T_high] "
+                    f"with T_low < T_high <= crystallization_C = {m.crystallization_C} (the "
+                    "crystallisation range lies below the melting range, without overlap)"
+                )
         eps = 1e-9 * max(W, Hh)
         for i, b in enumerate(self.bodies):
             key = f"bodies[{i}]"

@@ -157,7 +157,7 @@ def run_case(
         sim.t,
         enabled=progress,
         solidify=solidify,
-        T_c=min(m.crystallization_C for m in case.materials.values()),
+        T_c=min(m.solid_below_C() for m in case.materials.values()),
         T_wall=min(walls) if walls else math.nan,
     )
     step_wall = 0.0

@@ -13,7 +13,8 @@ class Progress:
 
     The time left of a run to solidification is estimated from the cooling of the hottest point
     towards the wall temperature: over the last two frames after the peak, T_max - T_wall
-    decays as exp(-t / tau); the run ends about when T_max reaches T_c."""
+    decays as exp(-t / tau); the run ends about when T_max reaches T_c (with thermal
+    hysteresis, the bottom of the crystallisation range)."""
 
     def __init__(
         self,

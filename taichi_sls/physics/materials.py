@@ -2,13 +2,27 @@
 
 Each material's parameters live in one element of a struct field whose members carry the case
 file's key names, in SI: a key in C (``melt_C``) becomes the same name in kelvin (``melt_K``),
-every other key keeps its name and unit (``youngs_solid_Pa``). Three members are derived:
-``enthalpy_reference_K`` (``thermal.enthalpy_reference_C``) and the enthalpies at T_c and T_m.
+every other key keeps its name and unit (``youngs_solid_Pa``). Derived members:
+``enthalpy_reference_K`` (``thermal.enthalpy_reference_C``), the enthalpies at T_c and T_m, and
+the hysteresis flag with its range in K (``crystallization_range_C``).
 
 Enthalpy per unit mass (docs/model.md: an enthalpy update per point, T recovered from H):
     H(T) = int_{T_ref}^T c(T') dT' + l_s (1 - xi_s(T)),
 with c = xi_s c_c + (1 - xi_s) c_m and xi_s of eq. 33 clamped to [0, 1]. Between T_c and T_m the
 sensible part is quadratic in T (c varies linearly), so the inverse T(H) is closed form.
+
+Thermal hysteresis (``hysteresis`` = 1, docs/model.md): xi_s is a history variable. Melting
+follows eq. 33 on [T_c, T_m] (xi_m(T)); crystallisation the same linear law on [T_l, T_h]
+(xi_k(T)), with T_h <= T_c so that xi_k <= xi_m everywhere. Each update is
+    xi_s <- min(xi_m(T), max(xi_k(T), xi_s)):
+heating only melts (xi_s never above xi_m), cooling only crystallises (never below xi_k), and
+between the branches the fraction holds (a supercooled melt). The enthalpy of a state is
+    H(T, xi_s) = S(T) + l_s (1 - xi_s),
+S(T) = H(T) - l_s (1 - xi_m(T)) the sensible part of the melting branch, so the melting branch
+keeps the enthalpy above, bit for bit. (S's capacity follows the melting branch, c_c below T_c:
+a supercooled melt takes the solid's c; exact for Table 3's c_c = c_m.) For a given previous
+xi_s, H(T, update(T, xi_s)) rises monotonically in T (crystallisation branch, fraction held,
+melting branch), so the inverse T(H; xi_s) is again closed form and unique.
 """
 
 import taichi as ti
@@ -47,14 +61,18 @@ MATERIAL_MEMBERS = (
     "enthalpy_reference_K",
     "enthalpy_crystallization_J_kg",  # H(T_c)
     "enthalpy_melt_J_kg",  # H(T_m)
+    # thermal hysteresis (materials.NAME.crystallization_range_C): 1 when set; the range in K
+    # (without it, the melting range, unused)
+    "hysteresis",
+    "crystallization_low_K",
+    "crystallization_high_K",
 )
+INT_MEMBERS = ("viscosity_model", "hysteresis")
 
 
 def material_struct():
     """The struct type of one material (built after ti.init: ``float`` is the default precision)."""
-    return ti.types.struct(
-        **{k: ti.i32 if k == "viscosity_model" else float for k in MATERIAL_MEMBERS}
-    )
+    return ti.types.struct(**{k: ti.i32 if k in INT_MEMBERS else float for k in MATERIAL_MEMBERS})
 
 
 @ti.func
@@ -135,3 +153,98 @@ def enthalpy(mp: ti.template(), T):
     H = c_c * (ti.min(T, T_c) - mp.enthalpy_reference_K)
     H += c_c * s + (c_m - c_c) * s * s / (2.0 * dT) + mp.latent_heat_J_kg * s / dT
     return H + c_m * ti.max(T - T_m, 0.0)
+
+
+# ----------------------------------------------------------------------------- hysteresis
+# A point counts as on a branch (its latent heat in the apparent capacity) within this much of
+# the branch's fraction; it picks the capacity of the grid's heat step only, never the energy
+# (which the enthalpy carries exactly), so a loose tolerance is harmless.
+BRANCH_TOL = 1e-6
+
+
+@ti.func
+def crystallization_fraction(mp: ti.template(), T):
+    """xi_k(T): the solid fraction of the crystallisation branch, eq. 33's linear law on
+    [T_l, T_h], clamped to [0, 1]."""
+    T_l = mp.crystallization_low_K
+    T_h = mp.crystallization_high_K
+    return ti.min(1.0, ti.max(0.0, 1.0 - (T - T_l) / (T_h - T_l)))
+
+
+@ti.func
+def solid_fraction_history(mp: ti.template(), T, xi0):
+    """The solid fraction at T of a point whose fraction was xi0 (module docstring); eq. 33
+    without hysteresis."""
+    xi = solid_fraction(mp, T)
+    if mp.hysteresis:
+        xi = ti.min(xi, ti.max(crystallization_fraction(mp, T), xi0))
+    return xi
+
+
+@ti.func
+def enthalpy_history(mp: ti.template(), T, xi):
+    """H(T, xi_s) = S(T) + l_s (1 - xi_s) of the module docstring; H(T) without hysteresis."""
+    H = enthalpy(mp, T)
+    if mp.hysteresis:
+        H += mp.latent_heat_J_kg * (solid_fraction(mp, T) - xi)
+    return H
+
+
+@ti.func
+def _sensible_temperature(mp: ti.template(), S):
+    """The inverse of the melting branch's sensible enthalpy S(T)."""
+    T_c, T_m, c_c, c_m = _phase_range(mp)
+    Sc = mp.enthalpy_crystallization_J_kg
+    Sm = mp.enthalpy_melt_J_kg - mp.latent_heat_J_kg
+    T = 0.0 * S
+    if S <= Sc:
+        T = mp.enthalpy_reference_K + S / c_c
+    elif S >= Sm:
+        T = T_m + (S - Sm) / c_m
+    else:
+        a = (c_m - c_c) / (2.0 * (T_m - T_c))
+        q = S - Sc
+        T = T_c + 2.0 * q / (c_c + ti.sqrt(ti.max(c_c * c_c + 4.0 * a * q, 0.0)))
+    return T
+
+
+@ti.func
+def temperature_from_enthalpy_history(mp: ti.template(), H, xi0):
+    """The T at which a point whose fraction was xi0 holds enthalpy H, its fraction updated
+    (module docstring); exact inverse of H(T, solid_fraction_history(T, xi0))."""
+    T = temperature_from_enthalpy(mp, H)  # the melting branch
+    if mp.hysteresis:
+        T_c, T_m, c_c, c_m = _phase_range(mp)
+        l_s = mp.latent_heat_J_kg
+        if H < enthalpy(mp, T_c + (1.0 - xi0) * (T_m - T_c)):  # below where melting resumes
+            T = _sensible_temperature(mp, H - l_s * (1.0 - xi0))  # the fraction held
+            T_l = mp.crystallization_low_K
+            T_h = mp.crystallization_high_K
+            if T < T_l + (1.0 - xi0) * (T_h - T_l):
+                # crystallising: H = c_c (T - T_ref) + l_s (1 - xi_k(T)), with T <= T_h <= T_c
+                H_l = c_c * (T_l - mp.enthalpy_reference_K)
+                if H <= H_l:
+                    T = mp.enthalpy_reference_K + H / c_c
+                else:
+                    T = T_l + (H - H_l) / (c_c + l_s / (T_h - T_l))
+    return T
+
+
+@ti.func
+def heat_capacity_history(mp: ti.template(), T, xi):
+    """The apparent capacity of a point at (T, xi_s): the sensible capacity of the melting
+    branch, plus the latent heat per kelvin of the branch it lies on (melting: xi_s at xi_m
+    inside [T_c, T_m]; crystallising: xi_s at xi_k inside [T_l, T_h]); a point whose fraction
+    holds between the branches has none. Without hysteresis dH/dT as before."""
+    c = apparent_heat_capacity(mp, T)
+    if mp.hysteresis:
+        T_c, T_m, c_c, c_m = _phase_range(mp)
+        T_l = mp.crystallization_low_K
+        T_h = mp.crystallization_high_K
+        xi_m = solid_fraction(mp, T)
+        c = lerp_phase(xi_m, c_c, c_m)
+        if T > T_c and T < T_m and xi >= xi_m - BRANCH_TOL:
+            c += mp.latent_heat_J_kg / (T_m - T_c)
+        if T > T_l and T < T_h and xi <= crystallization_fraction(mp, T) + BRANCH_TOL:
+            c += mp.latent_heat_J_kg / (T_h - T_l)
+    return c

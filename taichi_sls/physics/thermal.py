@@ -20,6 +20,13 @@ t_thermal) (a relaxation in time, independent of the heat clock), as enthalpy: e
 conservative, and of order h^4 on a smooth field (d is then smooth), so the scheme stays second
 order.
 
+Thermal hysteresis (``cfg.hysteresis``, some material sets ``crystallization_range_C``): the
+solid fraction is history (physics/materials.py). The enthalpy stays the carried state and
+eq. 30's latent term stays inside it: T comes from (H, previous xi_s), xi_s is then updated at
+T, and c_p is the apparent capacity of the branch the point is on (melting, crystallising, or
+none while the fraction holds). The energy balance is untouched: it never depended on c_p.
+Without it (``ti.static``) the code is the one above.
+
 Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
 increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
@@ -38,11 +45,28 @@ from .laser import laser_source
 from .materials import (
     apparent_heat_capacity,
     enthalpy,
+    enthalpy_history,
+    heat_capacity_history,
     lerp_phase,
     solid_fraction,
+    solid_fraction_history,
     temperature_from_enthalpy,
+    temperature_from_enthalpy_history,
 )
 from .shape import STENCIL, node_weight
+
+
+@ti.func
+def point_heat_capacity(cfg: ti.template(), mp: ti.template(), T, xi):
+    """c_p of eq. 28: the apparent capacity dH/dT, with hysteresis that of the branch the point
+    is on (physics/materials.py). Any c_p > 0 moves the grid's heat exactly; it only sets how
+    the heat step spreads it."""
+    c = 0.0
+    if ti.static(cfg.hysteresis):
+        c = heat_capacity_history(mp, T, xi)
+    else:
+        c = apparent_heat_capacity(mp, T)
+    return c
 
 
 @ti.func
@@ -50,7 +74,7 @@ def p2g_heat_capacity(
     cfg: ti.template(), pt: ti.template(), nd: ti.template(), mat: ti.template(), p, base, w, dw
 ):
     mp = pt.mass[p]
-    c = apparent_heat_capacity(mat[pt.material[p]], pt.T[p])
+    c = point_heat_capacity(cfg, mat[pt.material[p]], pt.T[p], pt.solid_fraction[p])
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
         I = base + o
@@ -119,7 +143,7 @@ def p2g_heat_flux(
     mp = mat[pt.material[p]]
     if ti.static(cfg.subgrid_filter > 0.0):
         if w_fixed == 0.0:  # points beside a fixed wall take the grid temperature anyway
-            mc = pt.mass[p] * apparent_heat_capacity(mp, pt.T[p])
+            mc = pt.mass[p] * point_heat_capacity(cfg, mp, pt.T[p], pt.solid_fraction[p])
             d = pt.T[p] - T_grid
             for o in ti.static(ti.grouped(STENCIL)):
                 N, gN = node_weight(w, dw, o)
@@ -192,7 +216,7 @@ def g2p_heat(
     mp = mat[pt.material[p]]
     T0 = pt.T[p]
     xi0 = pt.solid_fraction[p]
-    c0 = apparent_heat_capacity(mp, T0)
+    c0 = point_heat_capacity(cfg, mp, T0, xi0)
     dH = c0 * dTg
     heat_out = 0.0
     if ti.static(cfg.subgrid_filter > 0.0):
@@ -202,12 +226,22 @@ def g2p_heat(
             dH -= cfg.subgrid_filter * c0 * ((T0 - T_grid) - d_smooth)
     if ti.static(cfg.any_fixed):
         if w_fixed > 0.0:
-            H_pic = enthalpy(mp, T_pic)
+            H_pic = 0.0
+            if ti.static(cfg.hysteresis):
+                H_pic = enthalpy_history(mp, T_pic, solid_fraction_history(mp, T_pic, xi0))
+            else:
+                H_pic = enthalpy(mp, T_pic)
             heat_out = -(pt.mass[p] * (H_pic - pt.enthalpy[p] - dH))
             dH = H_pic - pt.enthalpy[p]
     pt.enthalpy[p] += dH
-    T1 = temperature_from_enthalpy(mp, pt.enthalpy[p])
-    xi1 = solid_fraction(mp, T1)
+    T1 = 0.0
+    xi1 = 0.0
+    if ti.static(cfg.hysteresis):  # xi_s is history: T from (H, xi0), then xi0 updated at T
+        T1 = temperature_from_enthalpy_history(mp, pt.enthalpy[p], xi0)
+        xi1 = solid_fraction_history(mp, T1, xi0)
+    else:
+        T1 = temperature_from_enthalpy(mp, pt.enthalpy[p])
+        xi1 = solid_fraction(mp, T1)
     pt.T[p] = T1
     pt.solid_fraction[p] = xi1
     return T1 - T0, xi1 - xi0, heat_out

@@ -12,7 +12,7 @@ import numpy as np
 from ..config import Case, Material
 from ..physics.codes import ViscosityModel
 from ..physics.laser import LASER_MEMBERS
-from ..physics.materials import KELVIN, MATERIAL_MEMBERS
+from ..physics.materials import INT_MEMBERS, KELVIN, MATERIAL_MEMBERS
 
 # the material keys that are temperatures (C), kept in kelvin under the same name with _K
 TEMPERATURES_C = ("melt_C", "crystallization_C")
@@ -26,6 +26,13 @@ def material_values(m: Material, enthalpy_reference_C: float) -> dict[str, float
             vals[key[:-2] + "_K"] = v + KELVIN
         elif key == "viscosity_model":
             vals[key] = int(ViscosityModel[v.upper()])
+        elif key == "crystallization_range_C":
+            # hysteresis: the crystallisation range in K and the flag the kernels branch on; a
+            # material without it keeps its melting range both ways (physics/materials.py)
+            lo, hi = v if v is not None else (m.crystallization_C, m.melt_C)
+            vals["hysteresis"] = int(v is not None)
+            vals["crystallization_low_K"] = lo + KELVIN
+            vals["crystallization_high_K"] = hi + KELVIN
         else:
             vals[key] = v
     T_c, T_m = vals["crystallization_K"], vals["melt_K"]
@@ -44,7 +51,7 @@ def material_arrays(case: Case, names: list[str]) -> dict[str, np.ndarray]:
     """Every material's parameters, one array per struct member (for ``from_numpy``)."""
     rows = [material_values(case.materials[n], case.thermal.enthalpy_reference_C) for n in names]
     return {
-        k: np.array([r[k] for r in rows], dtype=np.int32 if k == "viscosity_model" else float)
+        k: np.array([r[k] for r in rows], dtype=np.int32 if k in INT_MEMBERS else float)
         for k in MATERIAL_MEMBERS
     }
 

@@ -95,6 +95,7 @@ class StepConfig:
     wall_T: tuple[float, ...]  # K
     any_fixed: bool
     subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
+    hysteresis: bool  # some material crystallises below its melting range (physics/thermal.py)
     # ---- mass and surface tension
     surface_method: SurfaceMethod
     se: SurfaceEnergyConfig
@@ -211,6 +212,8 @@ def step_config(
         subgrid_filter=-math.expm1(-case.thermal.subgrid_filter * dt * heat_every / thermal_limit)
         if thermal
         else 0.0,
+        hysteresis=thermal
+        and any(m.crystallization_range_C is not None for m in case.materials.values()),
         surface_method=method,
         se=SurfaceEnergyConfig(
             weight_lp=h / (2 * case.grid.points_per_cell)

@@ -88,6 +88,9 @@ BAD = [
     ({"materials": {"PA12": {"poisson": -1.0}}}, "poisson"),
     ({"materials": {"PA12": {"melt_C": 100.0}}}, "crystallization_C"),
     ({"materials": {"PA12": {"viscosity_model": "power"}}}, "viscosity_model"),
+    ({"materials": {"PA12": {"crystallization_range_C": [140.0, 150.0]}}}, "range_C"),
+    ({"materials": {"PA12": {"crystallization_range_C": [140.0, 130.0]}}}, "range_C"),
+    ({"materials": {"PA12": {"crystallization_range_C": [140.0]}}}, "range_C"),
     ({"bodies": [{"shape": "disc", "center_um": [10.0, 20.0], "radius_um": 20.0}]}, "bodies[0]"),
     ({"bodies": [{"shape": "star"}]}, "bodies[0].shape"),
     ({"bodies": [{"material": "steel"}]}, "bodies[0].material"),
@@ -111,6 +114,22 @@ def test_bad_input_names_the_key(extra, key):
     with pytest.raises(CaseError) as err:
         case_from_dict(data)
     assert key in str(err.value)
+
+
+def test_crystallisation_range_overlapping_the_melting_range_is_refused():
+    """The error names the key, the value and what is allowed; a range below is accepted."""
+    data = deep_update(
+        PAPER_SCENE, {"materials": {"PA12": {"crystallization_range_C": [140, 150]}}}
+    )
+    with pytest.raises(CaseError) as err:
+        case_from_dict(data)
+    msg = str(err.value)
+    assert "materials.PA12.crystallization_range_C = [140.0, 150.0]" in msg
+    assert "T_low < T_high <= crystallization_C = 146.0" in msg
+    ok = load_case(bundled_case("power25W"), ["materials.PA12.crystallization_range_C=[120, 130]"])
+    assert ok.materials["PA12"].crystallization_range_C == [120.0, 130.0]
+    assert ok.materials["PA12"].solid_below_C() == 120.0
+    assert case_from_dict(PAPER_SCENE).materials["PA12"].solid_below_C() == 146.0
 
 
 def test_unstable_fixed_dt_is_refused_with_the_limit():
