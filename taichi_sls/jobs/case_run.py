@@ -3,7 +3,9 @@
 Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``animation.gif``,
 ``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``outcome.png``,
 ``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
-``output.vtu = true``, ParaView point data. Every file is written atomically; an interrupted or
+``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed) adds
+``contacts.csv`` and ``contacts.png`` and the summary's ``bed`` record (jobs/bed_outcome.py),
+its verdict per contact. Every file is written atomically; an interrupted or
 failed run still leaves valid files and a summary that says so.
 """
 
@@ -18,12 +20,15 @@ from pathlib import Path
 from typing import Any
 
 from ..config import Case, case_to_toml
+from ..io.contacts_plot import plot_contacts
+from ..io.contacts_table import read_contacts, write_contacts
 from ..io.outcome_plot import plot_outcome
 from ..io.vtu import point_data
 from ..io.writer import OutputWriter
 from ..solver.guard import SimulationError
 from ..solver.scene import Scene
 from ..solver.simulation import Simulation
+from .bed_outcome import ContactHistory, bed_summary, describe_bed, is_bed
 from .outcome import NeckHistory, describe, neck_region, outcome
 from .progress import Progress
 from .schedule import frame_steps, settled
@@ -121,12 +126,16 @@ def run_case(
         "compile_s": sim.compile_s,
     }
     history = NeckHistory()
+    bed = ContactHistory(sim) if is_bed(case) else None
     warnings: list[str] = []
 
     def frame(index: int, guard: bool = True) -> dict[str, float]:
         mon = sim.monitors(guard=guard)
         writer.row(mon)
         history.add(mon)
+        if bed is not None and guard:  # not on the blown-up state of a failed run
+            bed.add(sim)
+            write_contacts(out_dir / "contacts.csv", bed.rows(sim))
         snap = sim.snapshot(full=writer.vtu)
         deform = snap[
             "displacement_um" if case.output.deformation == "displacement" else "plastic_strain"
@@ -145,7 +154,17 @@ def run_case(
         for row in writer.series.rows():
             history.add(row)
         prev = out_dir / "summary.json"
-        first = json.loads(prev.read_text())["initial"] if prev.is_file() else sim.monitors()
+        old = json.loads(prev.read_text()) if prev.is_file() else {}
+        first = old["initial"] if "initial" in old else sim.monitors()
+        if bed is not None and (out_dir / "contacts.csv").is_file():
+            d = old.get("bed", {}).get("relative_density", {})
+            bed.restore(
+                read_contacts(out_dir / "contacts.csv"),
+                {
+                    "relative_density": d.get("initial") or math.nan,
+                    "mean_top_m": (d.get("mean_top_initial_um") or math.nan) * 1e-6,
+                },
+            )
         print(f"resumed from {resume} at frame {k0}, t = {sim.t:.6g} s", file=sys.stderr)
     else:
         first = frame(0)
@@ -210,6 +229,19 @@ def run_case(
             solidified=solid and summary["status"] == "complete",
             baseline_um=baseline_um,
         )
+        if bed is not None:
+            summary["outcome"].update(
+                fused=None,
+                no_verdict=f"{len(case.bodies)} bodies: the verdict is per contact (summary "
+                "bed, contacts.csv)",
+            )
+            try:
+                rows = bed.rows(sim)
+                write_contacts(out_dir / "contacts.csv", rows)
+                summary["bed"] = bed_summary(sim, rows, bed.density_initial)
+                plot_contacts(out_dir, rows, pt.x.to_numpy() * 1e6)
+            except Exception as e:  # noqa: BLE001 -- never cost the run's other outputs
+                warnings.append(f"bed outcome not made ({type(e).__name__}: {e})")
         if summary["status"] == "max_time":
             warnings.append(
                 f"time.max_s = {case.time.max_s:g} s reached before the pair solidified and "
@@ -248,5 +280,7 @@ def complete_summary(
 def print_outcome(summary: dict[str, Any]) -> None:
     """The outcome lines of a finished run, on stderr."""
     print(describe(summary["outcome"]), file=sys.stderr)
+    if "bed" in summary:
+        print(describe_bed(summary["bed"]), file=sys.stderr)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)

@@ -39,7 +39,7 @@ def needs_baseline(case: Case) -> bool:
         and any(las.power_W > 0 and las.absorptivity > 0 for las in case.lasers)
         and ph.mechanics
         and ph.surface_tension
-        and len(case.bodies) >= 2
+        and len(case.bodies) == 2  # more bodies: per contact against the initial necks
     )
 
 

@@ -1,6 +1,10 @@
 """Contacts between bodies: which bodies touch, the initial neck that joins two touching discs,
 and the neck of every contact read across the line of its bodies' centres.
 
+In a bed a section across one contact also crosses the neighbouring particles, and the outermost
+crossings then span them: ``point_colour`` gives the colour of one pair's points alone, on which
+the bed's per-contact necks are read (``Simulation.pair_necks_m``).
+
 Contacts are a thing, not a column: the list is built once from the seeded points (two bodies
 touch where points of both lie within ``TOUCH_SPACINGS`` point spacings), and one function
 measures every contact, whatever its direction and wherever it lies.
@@ -157,3 +161,31 @@ def bilinear(
         + field[i + 1, j + 1] * fu * fv
     )
     return np.where(ok, out, outside)
+
+
+def _gimp_1d(xi: np.ndarray, h: float, lp: float) -> np.ndarray:
+    """The uGIMP weight of physics/shape.py (gimp_1d), in numpy."""
+    a = np.abs(xi)
+    r = h + lp - a
+    return np.where(
+        a < lp,
+        1.0 - (xi * xi + lp * lp) / (2.0 * h * lp),
+        np.where(a < h - lp, 1.0 - a / h, np.where(a < h + lp, r * r / (4.0 * h * lp), 0.0)),
+    )
+
+
+def point_colour(
+    x: np.ndarray, weight: np.ndarray, h: float, lp: float, off: int, shape: tuple[int, int]
+) -> np.ndarray:
+    """sum_p weight_p N_i(x_p) on the nodes (array index i at x = (i - off) h): the P2G of the
+    step (3x3 uGIMP stencil, clamped as solver/step.py clamps it) for a subset of the points.
+    With weight = m_p / (rho V_cell) it is the raw mass colour of those points alone."""
+    out = np.zeros(shape)
+    f = x / h
+    base = np.floor(f + 0.5).astype(int) - 1
+    w = [_gimp_1d((f - (base + a)) * h, h, lp) for a in range(3)]  # each (N, 2)
+    idx = np.clip(base + off, 1, np.array(shape) - 4)
+    for a in range(3):
+        for b in range(3):
+            np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b), weight * w[a][:, 0] * w[b][:, 1])
+    return out

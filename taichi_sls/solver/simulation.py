@@ -14,7 +14,7 @@ from ..config import Case
 from ..physics.materials import KELVIN
 from . import checkpoint
 from .blocks import BlockPlan
-from .contacts import neck_width, touching
+from .contacts import neck_width, point_colour, touching
 from .fields import State
 from .guard import Guard
 from .monitor import body_centroids_x, neck_measures, point_monitors
@@ -224,20 +224,59 @@ class Simulation:
         if not self.contacts:
             return []
         field = self._material_field(measure or self.neck_measure(), "centres")
-        x = self.state.points.x.to_numpy()
-        body, m = self.scene.body, self._mass
-        n_b = len(self._body_radius)
-        centre = (
-            np.stack(
-                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
-            )
-            / np.bincount(body, weights=m, minlength=n_b)[:, None]
-        )
+        centre = self.body_centres_m()
         cfg = self.state.cfg
         out = []
         for a, b in self.contacts:
             reach = min(self._body_radius[a], self._body_radius[b])
             out.append(neck_width(field, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
+        return out
+
+    @property
+    def body_radii_m(self) -> np.ndarray:
+        """Each body's equivalent radius sqrt(area / pi) as seeded (m): its reach for a neck."""
+        return self._body_radius
+
+    def body_centres_m(self, initial: bool = False) -> np.ndarray:
+        """Each body's mass centre (m), (bodies, 2): of the current points, or (``initial``) of
+        their start positions."""
+        pt = self.state.points
+        x = (pt.x0 if initial else pt.x).to_numpy()
+        body, m = self.scene.body, self._mass
+        n_b = len(self._body_radius)
+        return (
+            np.stack(
+                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
+            )
+            / np.bincount(body, weights=m, minlength=n_b)[:, None]
+        )
+
+    def pair_necks_m(self) -> list[float]:
+        """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
+        reads it but on the raw colour of the contact's two bodies alone: in a bed a section
+        across one contact also crosses the neighbours, whose material the outermost crossings
+        would count. Mass colour m_i / (rho V_cell), or the volume colour where the force uses
+        it; equal to :meth:`necks_m` on the colour for a case of two bodies."""
+        if not self.contacts:
+            return []
+        pt, cfg = self.state.points, self.state.cfg
+        x = pt.x.to_numpy()
+        if cfg.se.volume_colour:
+            weight = pt.volume0.to_numpy() * pt.J.to_numpy() / cfg.cell_volume
+        else:
+            weight = self._mass / (cfg.rho_ref * cfg.cell_volume)
+        body = self.scene.body
+        order = np.argsort(body, kind="stable")
+        bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
+        members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
+        centre = self.body_centres_m()
+        shape = (cfg.nx, cfg.ny)
+        out = []
+        for a, b in self.contacts:
+            sel = np.concatenate([members[a], members[b]])
+            c = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
+            reach = min(self._body_radius[a], self._body_radius[b])
+            out.append(neck_width(c, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
         return out
 
     def monitors(self, guard: bool = True) -> dict[str, float]:

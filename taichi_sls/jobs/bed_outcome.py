@@ -1,0 +1,236 @@
+"""The outcome of a bed run (a case of more than two bodies): per contact, the neck at the start,
+at the end of its melting and at the end, whether its neck region melted through and whether it
+fused; for the layer, its relative density before and after and the melt track's depth and width
+(jobs/bed_layer.py). The pair verdict of jobs/outcome.py reads bodies 0 and 1 only; a bed gets
+this one instead (docs/beds.md).
+
+Per contact (a, b) of ``Simulation.contacts``:
+
+- the contact point: on the line of the start centres, where the radical line of the two
+  bodies' equivalent circles crosses it (the tangency of two touching discs);
+- the neck region: the points of a and b whose start positions lie within
+  ``fusion.neck_region_cells`` cells of the line through the contact point across the line of
+  centres (and within the smaller radius of that point along it): for the pair of equal discs
+  this is the region of the pair verdict;
+- the necks: ``Simulation.pair_necks_m``, on the colour of the two bodies alone; at the start,
+  at the last output frame in which the neck region held melt (a point with liquid fraction > 0:
+  the neck as that contact's melting ends; NaN for a contact that never melted), and at the end;
+- melted through: ``fusion.melted_through`` of the region's points were fully molten at some
+  time (time_molten > 0), as in the pair verdict;
+- fused: melted through, refrozen (no melt left in the region at the end) and the final neck at
+  least (1 + ``fusion.neck_growth``) times the initial neck. The baseline is the initial neck,
+  not an unheated run: that run of a whole bed would double the cost, and the initial necks of a
+  bed are the fillet's, which do not depend on h. The adhesive growth a soft solid makes without
+  heat is therefore counted as growth; the same bed run without laser heat (absorptivity 0)
+  measures it per contact.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..config import Case
+from ..solver.simulation import Simulation
+from .bed_layer import melt_extent, relative_density
+from .outcome import laser_acted
+
+NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
+
+
+def is_bed(case: Case) -> bool:
+    """A case whose outcome is read per contact: more than two bodies."""
+    return len(case.bodies) > 2
+
+
+def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
+    """(contact points, unit vectors a -> b) of every contact (m), from the start centres."""
+    centre, radius = sim.body_centres_m(initial=True), sim.body_radii_m
+    points, normals = [], []
+    for a, b in sim.contacts:
+        d_vec = centre[b] - centre[a]
+        d = float(np.linalg.norm(d_vec))
+        e = d_vec / d
+        s = (d * d + radius[a] ** 2 - radius[b] ** 2) / (2.0 * d)  # radical line from a
+        points.append(centre[a] + s * e)
+        normals.append(e)
+    return np.reshape(points, (-1, 2)), np.reshape(normals, (-1, 2))
+
+
+def neck_regions(sim: Simulation, points: np.ndarray, normals: np.ndarray) -> list[np.ndarray]:
+    """Per contact, which points (in their current order) lie in its neck region."""
+    x0 = sim.state.points.x0.to_numpy()
+    body = sim.scene.body
+    half = sim.case.fusion.neck_region_cells * sim.state.cfg.h
+    out = []
+    for (a, b), p, e in zip(sim.contacts, points, normals, strict=True):
+        rel = x0 - p
+        along = np.abs(rel @ e)
+        across = np.abs(rel[:, 0] * e[1] - rel[:, 1] * e[0])
+        reach = min(sim.body_radii_m[a], sim.body_radii_m[b])
+        out.append((along <= half) & (across <= reach) & ((body == a) | (body == b)))
+    return out
+
+
+class ContactHistory:
+    """Follows every contact's neck and melt frame by frame (``add`` at each output frame)."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.contacts = list(sim.contacts)
+        self.points, self.normals = contact_geometry(sim)
+        n = len(self.contacts)
+        self.initial = np.full(n, np.nan)
+        self.melt = np.full(n, np.nan)
+        self.melt_s = np.full(n, np.nan)
+        self.final = np.full(n, np.nan)
+        self.molten_now = np.zeros(n, dtype=bool)
+        self.density_initial: dict[str, float] | None = None
+        self.started = False
+
+    def add(self, sim: Simulation) -> None:
+        necks = np.array(sim.pair_necks_m()) * 1e6
+        liquid = 1.0 - sim.state.points.solid_fraction.to_numpy()
+        regions = neck_regions(sim, self.points, self.normals)
+        self.molten_now = np.array([bool(np.any(liquid[r] > 0.0)) for r in regions], dtype=bool)
+        if not self.started:
+            self.initial = necks.copy()
+            self.density_initial = layer_density(sim)
+            self.started = True
+        self.melt = np.where(self.molten_now, necks, self.melt)
+        self.melt_s = np.where(self.molten_now, sim.t, self.melt_s)
+        self.final = necks
+
+    def restore(self, rows: list[dict[str, float]], density: dict | None) -> None:
+        """Continue a resumed run from its contacts table and summary (the frames before the
+        checkpoint are not stepped again)."""
+        if len(rows) != len(self.contacts):
+            return
+        self.initial = np.array([r["neck_initial_um"] for r in rows])
+        self.melt = np.array([r["neck_melt_um"] for r in rows])
+        self.melt_s = np.array([r["melt_end_s"] for r in rows])
+        self.density_initial = density
+        self.started = True
+
+    def rows(self, sim: Simulation) -> list[dict[str, float]]:
+        """The contacts table (contacts.csv), one row per contact, with the verdict."""
+        f = sim.case.fusion
+        tm = sim.state.points.time_molten.to_numpy()
+        regions = neck_regions(sim, self.points, self.normals)
+        heated = laser_acted(sim.case)
+        out = []
+        for k, ((a, b), p) in enumerate(zip(self.contacts, self.points, strict=True)):
+            r = regions[k]
+            melted = float(np.mean(tm[r] > 0.0)) if r.any() else 0.0
+            through = heated and melted >= f.melted_through
+            refrozen = not self.molten_now[k]
+            grown = self.final[k] >= (1.0 + f.neck_growth) * self.initial[k]
+            out.append(
+                {
+                    "body_a": a,
+                    "body_b": b,
+                    "x_um": p[0] * 1e6,
+                    "y_um": p[1] * 1e6,
+                    "neck_initial_um": self.initial[k],
+                    "neck_melt_um": self.melt[k],
+                    "melt_end_s": self.melt_s[k],
+                    "neck_final_um": self.final[k],
+                    "neck_region_melted_fraction": melted,
+                    "melted_through": int(through),
+                    "refrozen": int(refrozen),
+                    "fused": int(bool(through and refrozen and grown)),
+                }
+            )
+        return out
+
+
+def layer_density(sim: Simulation) -> dict[str, float]:
+    """The layer's relative density now (jobs/bed_layer.py) between the bed's side walls."""
+    cfg = sim.state.cfg
+    rep = sim.case.bed_report()
+    if rep is not None:
+        lo, hi = (v * 1e-6 for v in rep["x_range_um"])
+    else:  # bodies listed one by one: the x-extent of the points as seeded
+        x0 = sim.scene.x[:, 0]
+        half = 0.5 * cfg.h / sim.case.grid.points_per_cell
+        lo, hi = float(x0.min()) - half, float(x0.max()) + half
+    return relative_density(
+        sim.raw_colour(), cfg.h, cfg.off, (lo, hi), sim.case.domain.height_um * 1e-6
+    )
+
+
+def _quartiles(v: np.ndarray) -> dict[str, float]:
+    v = v[np.isfinite(v)]
+    if len(v) == 0:
+        return {"q25": math.nan, "median": math.nan, "q75": math.nan, "count": 0}
+    q = np.percentile(v, [25, 50, 75])
+    return {"q25": float(q[0]), "median": float(q[1]), "q75": float(q[2]), "count": int(len(v))}
+
+
+def bed_summary(
+    sim: Simulation, rows: list[dict[str, float]], density_initial: dict | None
+) -> dict[str, Any]:
+    """The summary's ``bed`` record: contacts, fused share, neck statistics, the layer's
+    relative density before and after (with the generator's packing fractions) and the melt
+    track (lengths in um)."""
+    n = len(rows)
+    col = {k: np.array([r[k] for r in rows], dtype=float) for k in (*NECKS, "fused")}
+    after = layer_density(sim)
+    pt = sim.state.points
+    spacing = sim.state.cfg.h / sim.case.grid.points_per_cell
+    melt = melt_extent(
+        pt.x0.to_numpy(), pt.time_molten.to_numpy(), sim.case.top_um() * 1e-6, spacing
+    )
+    rep = sim.case.bed_report() or {}
+    return {
+        "contacts": n,
+        "fused": int(col["fused"].sum()),
+        "fused_fraction": float(col["fused"].mean()) if n else math.nan,
+        "melted_through": int(sum(r["melted_through"] for r in rows)),
+        "still_molten": int(sum(1 - r["refrozen"] for r in rows)),
+        "rule": (
+            f"per contact: neck region melted through (>= {sim.case.fusion.melted_through:g} of "
+            f"its points above T_m at some time), refrozen, and final neck >= "
+            f"(1 + {sim.case.fusion.neck_growth:g}) x initial neck"
+        ),
+        **{k: _quartiles(col[k]) for k in NECKS},
+        "relative_density": {
+            "initial": (density_initial or {}).get("relative_density", math.nan),
+            "final": after["relative_density"],
+            "mean_top_initial_um": (density_initial or {}).get("mean_top_m", math.nan) * 1e6,
+            "mean_top_final_um": after["mean_top_m"] * 1e6,
+            "generator_envelope": rep.get("envelope", math.nan),
+            "generator_bulk": rep.get("bulk", math.nan),
+        },
+        "layer_top_um": sim.case.top_um(),
+        "melt_depth_um": melt["melt_depth_m"] * 1e6,
+        "melt_bottom_um": melt["melt_bottom_m"] * 1e6,
+        "track_width_um": melt["track_width_m"] * 1e6,
+        "molten_points": melt["molten_points"],
+    }
+
+
+def describe_bed(b: dict[str, Any]) -> str:
+    """The bed record as lines for the run's printout."""
+
+    def q(k: str) -> str:
+        s = b[k]
+        if not s["count"]:
+            return "-"
+        return f"{s['median']:.2f} um (quartiles {s['q25']:.2f}-{s['q75']:.2f})"
+
+    d = b["relative_density"]
+    return (
+        f"bed: {b['contacts']} contacts, {b['fused']} fused ({b['fused_fraction']:.0%}), "
+        f"{b['melted_through']} melted through, {b['still_molten']} still molten\n"
+        f"  neck median: {q('neck_initial_um')} at the start, {q('neck_melt_um')} as melting "
+        f"ended, {q('neck_final_um')} at the end\n"
+        f"  relative density {d['initial']:.3f} -> {d['final']:.3f} (generator: envelope "
+        f"{d['generator_envelope']:.3f}, bulk {d['generator_bulk']:.3f}); mean top "
+        f"{d['mean_top_initial_um']:.1f} -> {d['mean_top_final_um']:.1f} um\n"
+        f"  melt track: depth {b['melt_depth_um']:.1f} um below the top at "
+        f"{b['layer_top_um']:.1f} um (down to {b['melt_bottom_um']:.1f} um above the plate), "
+        f"width {b['track_width_um']:.1f} um "
+        f"({b['molten_points']} points ever fully molten)\n  rule: {b['rule']}"
+    )

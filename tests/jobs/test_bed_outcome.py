@@ -1,0 +1,208 @@
+"""The outcome of a bed run (jobs/bed_outcome.py, jobs/bed_layer.py): the contacts table, the
+layer's relative density, the melt track, on a six-disc CSV bed at h = 4 um run for 30 us with
+and without laser heat (about 25 s together), and the measures on synthetic fields."""
+
+import csv
+import json
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from helpers import PAPER_SCENE, deep_update, make_case
+
+from taichi_sls.jobs.bed_layer import melt_extent, relative_density
+from taichi_sls.jobs.bed_outcome import contact_geometry, neck_regions
+from taichi_sls.jobs.case_run import run_case
+from taichi_sls.jobs.outcome import neck_region
+from taichi_sls.solver.contacts import fillet, point_colour
+from taichi_sls.solver.scene import build_scene
+from taichi_sls.solver.simulation import Simulation
+
+# three discs on the plate, two in their valleys, a small one on those two: every pair that
+# touches does so exactly (9 tangencies), the walls at x = 0 and 120 um
+H0 = 20.0 + math.sqrt(40.0**2 - 20.0**2)
+DISCS = [
+    (20.0, 20.0, 20.0),
+    (60.0, 20.0, 20.0),
+    (100.0, 20.0, 20.0),
+    (40.0, H0, 20.0),
+    (80.0, H0, 20.0),
+    (60.0, H0 + math.sqrt(32.0**2 - 20.0**2), 12.0),
+]
+TANGENT = [(0, 1), (0, 3), (1, 2), (1, 3), (1, 4), (2, 4), (3, 4), (3, 5), (4, 5)]
+H_UM = 4.0
+
+
+def _bed_case(tmp, absorptivity: float, end_s: float = 3e-5, frames: int = 3):
+    path = tmp / "bed.csv"
+    path.write_text("x_um,y_um,radius_um\n" + "".join(f"{x},{y},{r}\n" for x, y, r in DISCS))
+    return make_case(
+        {
+            "case": {"name": "bed6"},
+            "grid": {"spacing_um": H_UM},
+            "bed": {"csv": str(path)},
+            "contact": {"initial": "fillet"},
+            "lasers": [
+                {"power_W": 25.0, "x_start_um": 60.0, "off_s": 1e-3, "absorptivity": absorptivity}
+            ],
+            "time": {"end_s": end_s},
+            "output": {"frames": frames, "png": False, "gif": False},
+        }
+    )
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """(case, out folder) of the bed under a 25 W beam and unheated (absorptivity 0)."""
+    out = {}
+    for name, a in (("laser", 0.85), ("dark", 0.0)):
+        tmp = tmp_path_factory.mktemp(name)
+        case = _bed_case(tmp, a)
+        run_case(case, tmp / "out", progress=False)
+        out[name] = (case, tmp / "out")
+    return out
+
+
+def _table(folder):
+    return list(csv.DictReader((folder / "contacts.csv").open()))
+
+
+def _bed(folder):
+    return json.loads((folder / "summary.json").read_text())["bed"]
+
+
+def test_one_row_per_contact_with_the_fillet_neck_at_the_start(runs):
+    """Every tangency is a row, at its tangency point, with a finite initial neck. The fillet
+    neck (rho = 2 um) is 14.33 um between the 20 um discs and 11.97 um to the 12 um disc; at
+    h = 4 um the colour fills each cusp by up to a cell (the pair reads 17.40 for 14.33,
+    docs/convergence.md), so the neck read lies between the fillet's and one cell more."""
+    case, folder = runs["laser"]
+    rows = _table(folder)
+    assert [(int(r["body_a"]), int(r["body_b"])) for r in rows] == TANGENT
+    assert _bed(folder)["contacts"] == len(TANGENT)
+    for r in rows:
+        (xa, ya, ra), (xb, yb, rb) = DISCS[int(r["body_a"])], DISCS[int(r["body_b"])]
+        neck = fillet([xa, ya], ra, [xb, yb], rb, case.contact.fillet_radius_um).neck_width
+        read = float(r["neck_initial_um"])
+        assert neck - 0.5 <= read <= neck + H_UM, (r["body_a"], r["body_b"], read, neck)
+        tangency = np.array([xa, ya]) + ra / (ra + rb) * np.array([xb - xa, yb - ya])
+        # the equivalent radii of the seeded (staircase) discs: within a quarter cell
+        assert np.hypot(float(r["x_um"]) - tangency[0], float(r["y_um"]) - tangency[1]) < 1.0
+
+
+def test_density_before_is_the_beds_packing_and_the_melt_densifies(runs):
+    """At the start the layer's relative density is the generator's envelope packing (0.890
+    for these discs) read on the grid: the seeded material adds the fillet bridges (+1.5 %) and
+    the staircase (+0.7 %), and the colour at h = 4 um fills each contact's cusps (+1.1 %): so
+    it lies within [envelope, envelope + 0.04]. Heated, the layer sinks and densifies."""
+    case, folder = runs["laser"]
+    d = _bed(folder)["relative_density"]
+    assert d["generator_envelope"] == pytest.approx(case.bed_report()["envelope"])
+    assert d["generator_envelope"] <= d["initial"] <= d["generator_envelope"] + 0.04
+    assert d["final"] > d["initial"] and d["mean_top_final_um"] < d["mean_top_initial_um"]
+    dark = _bed(runs["dark"][1])["relative_density"]
+    assert dark["initial"] == pytest.approx(d["initial"], abs=1e-12)  # the same start
+
+
+def test_melt_track_and_verdict_with_and_without_laser(runs):
+    """Unheated nothing melts: no depth, no width, no contact melted through or fused, no neck
+    at the end of melting. Heated from above the 91.6 um high bed melts: a track deeper than
+    one particle and wider than the beam's spot radius, no deeper than the bed, and contacts
+    still molten at 30 us are not (yet) fused."""
+    dark, heated = _bed(runs["dark"][1]), _bed(runs["laser"][1])
+    assert dark["melt_depth_um"] == 0.0 and dark["track_width_um"] == 0.0
+    assert dark["fused"] == 0 and dark["fused_fraction"] == 0.0 and dark["melted_through"] == 0
+    assert all(r["neck_melt_um"] == "" for r in _table(runs["dark"][1]))
+    top = max(y + r for _, y, r in DISCS)
+    assert 40.0 < heated["melt_depth_um"] <= top + H_UM / 4
+    assert 50.0 < heated["track_width_um"] <= 120.0
+    assert 0.0 <= heated["fused_fraction"] <= 1.0 and heated["melted_through"] > 0
+    for r in _table(runs["laser"][1]):
+        assert int(r["fused"]) <= int(r["refrozen"]) * int(r["melted_through"])
+        if int(r["melted_through"]):
+            assert math.isfinite(float(r["neck_melt_um"]))
+    assert (runs["laser"][1] / "contacts.png").stat().st_size < 300_000
+
+
+def test_a_resumed_bed_run_keeps_its_contact_history(runs, tmp_path):
+    """Stopped after the first of its three frames and resumed from the checkpoint, the run
+    ends with the contacts table and bed record of the uninterrupted run (the necks at the
+    start come back from contacts.csv, the density at the start from summary.json)."""
+    run_case(
+        _bed_case(tmp_path, 0.85, 1e-5, 1), tmp_path / "out", progress=False, checkpoint_every=1
+    )
+    run_case(
+        _bed_case(tmp_path, 0.85),
+        tmp_path / "out",
+        progress=False,
+        resume=tmp_path / "out" / "checkpoint.npz",
+    )
+    full = runs["laser"][1]
+    assert _table(tmp_path / "out") == _table(full)
+    assert _bed(tmp_path / "out") == _bed(full)
+
+
+def test_pair_colour_is_the_steps_p2g(tmp_path):
+    """The colour a pair's necks are read on is the step's P2G restricted to their points:
+    over every point it is the solver's raw colour to round-off."""
+    sim = Simulation(_bed_case(tmp_path, 0.85))
+    cfg = sim.state.cfg
+    x = sim.state.points.x.to_numpy()
+    weight = sim.state.points.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
+    mine = point_colour(x, weight, cfg.h, cfg.lp, cfg.off, (cfg.nx, cfg.ny))
+    assert np.abs(mine - sim.raw_colour()).max() < 1e-12
+    assert len(sim.pair_necks_m()) == len(TANGENT)
+
+
+def test_relative_density_of_a_block_with_a_hole():
+    """A full block of material from the plate up to a flat top (c = 1 on its nodes, 0 above:
+    the c = 1/2 crossing half a cell above the last full node row) reads 1; a hole of 4 x 4
+    cells in it removes its area."""
+    h, off = 1.0, 2
+    c = np.zeros((44, 30))
+    c[off : off + 41, : off + 11] = 1.0  # x 0..40, y up to 10 (+ h/2 to the crossing)
+    full = relative_density(c, h, off, (0.0, 40.0), 28.0)
+    assert full["relative_density"] == pytest.approx(1.0)
+    assert full["mean_top_m"] == pytest.approx(10.5, abs=0.13)
+    # nodes x 10..13, y 3..6 empty: c < 1/2 from half a cell before them to half after, 4 x 4
+    c[off + 10 : off + 14, off + 3 : off + 7] = 0.0
+    holed = relative_density(c, h, off, (0.0, 40.0), 28.0)
+    assert holed["relative_density"] == pytest.approx(1.0 - 16.0 / (40.0 * 10.5), abs=0.005)
+
+
+def test_melt_extent_counts_each_point_with_its_square():
+    x0 = np.array([[10.0, 50.0], [20.0, 40.0], [30.0, 20.0], [90.0, 5.0]])
+    tm = np.array([1e-6, 2e-6, 1e-6, 0.0])
+    e = melt_extent(x0, tm, 60.0, 2.0)
+    assert e["melt_depth_m"] == pytest.approx(60.0 - 19.0) and e["melt_bottom_m"] == 19.0
+    assert e["track_width_m"] == pytest.approx(22.0) and e["molten_points"] == 3
+    assert melt_extent(x0, np.zeros(4), 60.0, 2.0)["melt_depth_m"] == 0.0
+
+
+def test_a_pairs_contact_region_is_the_pair_verdicts_neck_region():
+    """For the paper's pair the per-contact neck region (the slab about the contact's radical
+    line) holds the same points as the pair verdict's (about the mid-plane of bodies 0, 1)."""
+    case = make_case(deep_update(PAPER_SCENE, {"contact": {"initial": "fillet"}}))
+    sc = build_scene(case)
+    m = sc.vol
+    centres = np.array(
+        [np.average(sc.x[sc.body == b], axis=0, weights=m[sc.body == b]) for b in (0, 1)]
+    )
+    area = np.bincount(sc.body, weights=sc.vol)
+    sim = SimpleNamespace(
+        case=case,
+        contacts=[(0, 1)],
+        scene=sc,
+        body_radii_m=np.sqrt(area / np.pi),
+        body_centres_m=lambda initial: centres,
+        state=SimpleNamespace(
+            points=SimpleNamespace(x0=SimpleNamespace(to_numpy=lambda: sc.x)),
+            cfg=SimpleNamespace(h=case.grid.spacing_um * 1e-6),
+        ),
+    )
+    points, normals = contact_geometry(sim)
+    assert points[0] == pytest.approx(0.5 * (centres[0] + centres[1]))
+    (region,) = neck_regions(sim, points, normals)
+    pair = neck_region(case, sc.x, sc.body, m)
+    assert region.sum() > 0 and np.array_equal(region, pair)
