@@ -32,9 +32,9 @@ def disc_curvature_error(R: float, h: float, **surface) -> tuple[float, float]:
         # at R/h = 20 (2 % mean, 10 % RMS); at R/h = 10 the blur's shrinkage sigma^2 / 2R shows
         # as a +4 % bias, allowed up to 6 %.
         (20.0, 2.0, 0.06, 0.10),
-        (10.0, 1.0, 0.06, 0.10),
-        (20.0, 1.0, 0.02, 0.10),
-        (40.0, 2.0, 0.02, 0.10),
+        pytest.param(10.0, 1.0, 0.06, 0.10, marks=pytest.mark.slow),
+        pytest.param(20.0, 1.0, 0.02, 0.10, marks=pytest.mark.slow),
+        pytest.param(40.0, 2.0, 0.02, 0.10, marks=pytest.mark.slow),
     ],
 )
 def test_disc_curvature_from_points(R, h, mean_tol, rms_tol):
@@ -44,6 +44,7 @@ def test_disc_curvature_from_points(R, h, mean_tol, rms_tol):
     assert rms < rms_tol
 
 
+@pytest.mark.slow  # the CSF option's longer runs; curvature and Laplace stay in the default
 def test_unsmoothed_level_set_is_not_usable():
     """Why the smoothing is part of the method: eq. 21 redistanced, no smoothing, errs by order
     one and grows with R/h (the points' staircase amplified by (R/h)^2)."""
@@ -67,6 +68,7 @@ def test_laplace_pressure_of_a_static_disc():
     assert r.info["v_over_capillary"] < 1e-2
 
 
+@pytest.mark.slow  # the CSF option's longer runs; curvature and Laplace stay in the default
 def test_square_relaxes_towards_a_disc():
     """A square of soft, low-viscosity Maxwell fluid (cases/verification/square.toml) rounds off
     under surface tension, keeping its area."""
@@ -136,6 +138,7 @@ def _floating_disc(initial_stress: str):
     )
 
 
+@pytest.mark.slow  # the CSF option's longer runs; curvature and Laplace stay in the default
 def test_laplace_initial_stress_is_the_equilibrium_pressure():
     """initial_stress = "laplace": a disc starts with the in-plane pressure gamma/R (2D
     Young-Laplace), carried by the plane-strain elastic strain -p / 2(lambda + mu)."""
@@ -178,6 +181,7 @@ def test_laplace_initial_stress_keeps_a_disc_at_rest():
     assert swing["laplace"] < 0.25 * static
 
 
+@pytest.mark.slow  # the CSF option's longer runs; curvature and Laplace stay in the default
 def test_nolaser_neck_holds_and_kinetic_energy_decays():
     """Issue #4's laser-off check with the paper's force (cases/nolaser.toml, 1 ms): the
     contact line stays within 2 % of its start (measured: 8.27 -> 8.27-8.40 um) and the kinetic

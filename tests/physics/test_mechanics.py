@@ -83,6 +83,7 @@ def _bar(cells: int, v0: float) -> float:
     return ver.run(ver.load("bar", cells, sets)).errors["com_velocity"]
 
 
+@pytest.mark.slow  # three grids; the large-amplitude bar stays in the default suite
 def test_vibrating_bar_against_analytic_with_convergence():
     # v0 = 0.01 m/s: strain amplitude 1e-3, the linear regime the analytic solution describes
     errs = [_bar(n, v0=0.01) for n in (8, 16, 32)]

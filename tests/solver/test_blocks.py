@@ -41,6 +41,7 @@ def test_blocks_layout_matches_the_serial_one():
     assert mb["T_peak_C"] == pytest.approx(m["T_peak_C"], rel=1e-12)
 
 
+@pytest.mark.slow  # two more blocks runs; the default suite keeps blocks = serial
 def test_blocks_layout_does_not_depend_on_the_thread_count():
     """Every node takes its sums in one order whatever the threads: bitwise equal."""
     one = _run("blocks", threads=1)[3]
