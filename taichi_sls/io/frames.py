@@ -100,14 +100,8 @@ def material_raster(
     half-width FOOTPRINT_SPACINGS spacings) and each of ``values`` as the area-weighted mean of
     the points nearby (NaN where none has a finite value)."""
     ny, nx = shape
-    ok = np.isfinite(x).all(axis=1)
-    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64) if ok.any() else None
-    inside = (
-        np.zeros(0, dtype=bool)
-        if ij is None
-        else ((ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny))
-    )
-    flat = np.zeros(0, dtype=np.int64) if ij is None else ij[inside, 1] * nx + ij[inside, 0]
+    on, ij = _pixels(x, lo, pixel, shape)
+    flat = ij[on, 1] * nx + ij[on, 0]
     # a footprint beyond a tenth of the frame is the spacing of a blown-up state (points flung
     # apart): capped, the frame still draws in its usual time
     reach = FOOTPRINT_SPACINGS * spacing
@@ -129,7 +123,7 @@ def material_raster(
     fraction = spread(np.full(flat.size, area)) / (pixel * pixel)
     out = []
     for v in values:
-        v = np.asarray(v, dtype=float)[ok][inside]
+        v = np.asarray(v, dtype=float)[on]
         good = np.isfinite(v)
         num = spread(np.where(good, v * area, 0.0))
         den = spread(np.where(good, area, 0.0))
@@ -141,15 +135,26 @@ def _on_material(
     x: np.ndarray, material: np.ndarray, lo: tuple[float, float], pixel: float
 ) -> np.ndarray:
     """Which points lie on a material pixel (non-finite points and those off the raster: no)."""
-    ny, nx = material.shape
+    on, ij = _pixels(x, lo, pixel, material.shape)
     out = np.zeros(len(x), dtype=bool)
-    ok = np.isfinite(x).all(axis=1)
-    ij = np.floor((x[ok] - np.asarray(lo)) / pixel).astype(np.int64)
-    inside = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
-    hit = np.zeros(len(ij), dtype=bool)
-    hit[inside] = material[ij[inside, 1], ij[inside, 0]]
-    out[ok] = hit
+    out[on] = material[ij[on, 1], ij[on, 0]]
     return out
+
+
+def _pixels(
+    x: np.ndarray, lo: tuple[float, float], pixel: float, shape: tuple[int, int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each point's pixel (i, j) on a raster of ``shape`` (ny, nx) and whether it lies on it
+    (a non-finite point, or one off the raster: no)."""
+    ny, nx = shape
+    with np.errstate(invalid="ignore", over="ignore"):
+        cell = np.floor((x - np.asarray(lo)) / pixel)
+    # compared as floats first: the cell of a point flung far by a blow-up fits no integer
+    on = np.isfinite(cell).all(axis=1)
+    on &= (cell[:, 0] >= 0) & (cell[:, 0] < nx) & (cell[:, 1] >= 0) & (cell[:, 1] < ny)
+    ij = np.zeros((len(x), 2), dtype=np.int64)
+    ij[on] = cell[on].astype(np.int64)
+    return on, ij
 
 
 def save_png(fig: Figure, path: Path, dpi: int) -> None:
