@@ -220,17 +220,24 @@ def describe_bed(b: dict[str, Any]) -> str:
             return "-"
         return f"{s['median']:.2f} um (quartiles {s['q25']:.2f}-{s['q75']:.2f})"
 
+    def num(v: float | None, fmt: str) -> str:  # NaN comes back from the JSON as None
+        return "-" if v is None or not math.isfinite(v) else format(v, fmt)
+
+    def um(v: float | None) -> str:
+        return "-" if v is None or not math.isfinite(v) else f"{v:.1f} um"
+
     d = b["relative_density"]
     return (
-        f"bed: {b['contacts']} contacts, {b['fused']} fused ({b['fused_fraction']:.0%}), "
+        f"bed: {b['contacts']} contacts, {b['fused']} fused ({num(b['fused_fraction'], '.0%')}), "
         f"{b['melted_through']} melted through, {b['still_molten']} still molten\n"
         f"  neck median: {q('neck_initial_um')} at the start, {q('neck_melt_um')} as melting "
         f"ended, {q('neck_final_um')} at the end\n"
-        f"  relative density {d['initial']:.3f} -> {d['final']:.3f} (generator: envelope "
-        f"{d['generator_envelope']:.3f}, bulk {d['generator_bulk']:.3f}); mean top "
+        f"  relative density {num(d['initial'], '.3f')} -> {num(d['final'], '.3f')} (generator: "
+        f"envelope {num(d['generator_envelope'], '.3f')}, bulk {num(d['generator_bulk'], '.3f')});"
+        " mean top "
         f"{d['mean_top_initial_um']:.1f} -> {d['mean_top_final_um']:.1f} um\n"
         f"  melt track: depth {b['melt_depth_um']:.1f} um below the top at "
-        f"{b['layer_top_um']:.1f} um (down to {b['melt_bottom_um']:.1f} um above the plate), "
+        f"{b['layer_top_um']:.1f} um (down to {um(b['melt_bottom_um'])} above the plate), "
         f"width {b['track_width_um']:.1f} um "
         f"({b['molten_points']} points ever fully molten)\n  rule: {b['rule']}"
     )

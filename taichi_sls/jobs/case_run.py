@@ -279,8 +279,9 @@ def complete_summary(
 
 def print_outcome(summary: dict[str, Any]) -> None:
     """The outcome lines of a finished run, on stderr."""
-    print(describe(summary["outcome"]), file=sys.stderr)
-    if "bed" in summary:
+    if "bed" in summary:  # the pair outcome reads bodies 0 and 1, which means nothing in a bed
         print(describe_bed(summary["bed"]), file=sys.stderr)
+    else:
+        print(describe(summary["outcome"]), file=sys.stderr)
     for w in summary.get("warnings", []):
         print(f"warning: {w}", file=sys.stderr)

@@ -206,3 +206,41 @@ def test_a_pairs_contact_region_is_the_pair_verdicts_neck_region():
     (region,) = neck_regions(sim, points, normals)
     pair = neck_region(case, sc.x, sc.body, m)
     assert region.sum() > 0 and np.array_equal(region, pair)
+
+
+def test_the_bed_printout_reads_a_summary_back_from_json():
+    """A finished run's summary is printed again from summary.json, where NaN is null: the
+    printout says '-' for what is not a number (no contact, nothing molten)."""
+    import json
+
+    from taichi_sls.jobs.bed_outcome import describe_bed
+
+    nothing = {"count": 0, "median": None, "q25": None, "q75": None}
+    bed = {
+        "contacts": 0,
+        "fused": 0,
+        "fused_fraction": float("nan"),
+        "melted_through": 0,
+        "still_molten": 0,
+        "rule": "per contact",
+        "layer_top_um": 100.0,
+        "melt_depth_um": 0.0,
+        "melt_bottom_um": float("nan"),
+        "track_width_um": 0.0,
+        "molten_points": 0,
+        "neck_initial_um": nothing,
+        "neck_melt_um": nothing,
+        "neck_final_um": nothing,
+        "relative_density": {
+            "initial": 0.8,
+            "final": 0.8,
+            "generator_envelope": 0.79,
+            "generator_bulk": float("nan"),
+            "mean_top_initial_um": 90.0,
+            "mean_top_final_um": 90.0,
+        },
+    }
+    text = json.dumps(bed).replace("NaN", "null")  # what the summary writer leaves
+    lines = describe_bed(json.loads(text)).splitlines()
+    assert lines[0] == "bed: 0 contacts, 0 fused (-), 0 melted through, 0 still molten"
+    assert "bulk -" in lines[2] and "down to - above the plate" in lines[3]
