@@ -149,11 +149,3 @@ def neck_measures(
     if best_i < 0:
         return float("nan"), float("nan")
     return float(best), column_span(phi[best_i], h)
-
-
-def body_centroids_x(x: np.ndarray, body: np.ndarray, mass: np.ndarray) -> list[float]:
-    out = []
-    for b in range(int(body.max()) + 1):
-        sel = body == b
-        out.append(float(np.sum(x[sel, 0] * mass[sel]) / np.sum(mass[sel])))
-    return out

@@ -17,7 +17,7 @@ from .blocks import BlockPlan
 from .contacts import neck_width, point_colour, touching
 from .fields import State
 from .guard import Guard
-from .monitor import body_centroids_x, neck_measures, point_monitors
+from .monitor import neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
 from .step import advance, colour_only, init_box, level_set_only
@@ -192,9 +192,7 @@ class Simulation:
                 return 0.0, 0.0
             w = self.necks_m(measure)[0]
             return w, w
-        x = self.state.points.x.to_numpy()
-        cx = body_centroids_x(x, self.scene.body, self._mass)
-        lo, hi = sorted(cx[:2])
+        lo, hi = sorted(self.body_centres_m()[:2, 0])
         cfg = self.state.cfg
         return neck_measures(-self._material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
 
