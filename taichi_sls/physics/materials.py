@@ -104,19 +104,26 @@ def _phase_range(mp: ti.template()):
 @ti.func
 def temperature_from_enthalpy(mp: ti.template(), H):
     """Exact inverse of H(T) (module docstring)."""
+    return _branch_temperature(mp, H, mp.latent_heat_J_kg)
+
+
+@ti.func
+def _branch_temperature(mp: ti.template(), E, latent):
+    """The inverse of E(T) = the sensible enthalpy plus ``latent`` spread over [T_c, T_m]: H(T)
+    with the full latent heat, the melting branch's sensible part S(T) with none."""
     T_c, T_m, c_c, c_m = _phase_range(mp)
-    Hc = mp.enthalpy_crystallization_J_kg
-    Hm = mp.enthalpy_melt_J_kg
-    T = 0.0 * H
-    if H <= Hc:
-        T = mp.enthalpy_reference_K + H / c_c
-    elif H >= Hm:
-        T = T_m + (H - Hm) / c_m
+    Ec = mp.enthalpy_crystallization_J_kg
+    Em = mp.enthalpy_melt_J_kg - (mp.latent_heat_J_kg - latent)
+    T = 0.0 * E
+    if E <= Ec:
+        T = mp.enthalpy_reference_K + E / c_c
+    elif E >= Em:
+        T = T_m + (E - Em) / c_m
     else:
         dT = T_m - T_c
         a = (c_m - c_c) / (2.0 * dT)
-        b = c_c + mp.latent_heat_J_kg / dT
-        q = H - Hc
+        b = c_c + latent / dT
+        q = E - Ec
         # a s^2 + b s - q = 0, positive root, written to avoid cancellation when a -> 0
         s = 2.0 * q / (b + ti.sqrt(ti.max(b * b + 4.0 * a * q, 0.0)))
         T = T_c + s
@@ -193,19 +200,7 @@ def enthalpy_history(mp: ti.template(), T, xi):
 @ti.func
 def _sensible_temperature(mp: ti.template(), S):
     """The inverse of the melting branch's sensible enthalpy S(T)."""
-    T_c, T_m, c_c, c_m = _phase_range(mp)
-    Sc = mp.enthalpy_crystallization_J_kg
-    Sm = mp.enthalpy_melt_J_kg - mp.latent_heat_J_kg
-    T = 0.0 * S
-    if S <= Sc:
-        T = mp.enthalpy_reference_K + S / c_c
-    elif S >= Sm:
-        T = T_m + (S - Sm) / c_m
-    else:
-        a = (c_m - c_c) / (2.0 * (T_m - T_c))
-        q = S - Sc
-        T = T_c + 2.0 * q / (c_c + ti.sqrt(ti.max(c_c * c_c + 4.0 * a * q, 0.0)))
-    return T
+    return _branch_temperature(mp, S, 0.0)
 
 
 @ti.func
