@@ -2,8 +2,9 @@
 
     run CASE         run a case file (or a bundled case by name) with every output
     sweep SWEEP      a parameter sweep on Dask
-    bench STUDY      speed, accuracy, paper (the Table 2 cases), neck (the melted-pair study),
-                     refinement (the paper's cases under grid and dt refinement)
+    bench STUDY      speed, cost, implicit (both integrators side by side), accuracy, paper (the
+                     Table 2 cases), neck (the melted-pair study), refinement (the paper's cases
+                     under grid and dt refinement)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -128,7 +129,16 @@ def case_command(args: argparse.Namespace) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    from .studies import accuracy, cost_error, neck_study, paper, refinement, robustness, speed
+    from .studies import (
+        accuracy,
+        cost_error,
+        implicit_bench,
+        neck_study,
+        paper,
+        refinement,
+        robustness,
+        speed,
+    )
     from .studies.sweep import runner as sweep
 
     ap = argparse.ArgumentParser(
@@ -140,10 +150,11 @@ def parser() -> argparse.ArgumentParser:
     p.set_defaults(func=run_command)
     sweep.add_parser(sub)
     bench = sub.add_parser(
-        "bench", help="benchmarks and studies: speed, cost, accuracy, paper, neck, refinement"
+        "bench",
+        help="benchmarks and studies: speed, cost, implicit, accuracy, paper, neck, refinement",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
-    for module in (speed, cost_error, accuracy, paper, neck_study, refinement):
+    for module in (speed, cost_error, implicit_bench, accuracy, paper, neck_study, refinement):
         module.add_parser(studies)
     robustness.add_parser(sub)
     p = sub.add_parser("case", help="print the case-file reference (every key, default, unit)")

@@ -70,6 +70,47 @@ class Time(Model):
         description="heat step as a fraction of the thermal stability limit for heat_every = "
         '"auto"',
     )
+    integrator: Literal["explicit", "implicit"] = Field(
+        "explicit",
+        description="explicit: the paper's step (eqs. 10-18), bounded by the elastic, capillary "
+        "and viscous limits; implicit: backward Euler for the grid velocities (Newton on the "
+        "momentum balance with the Perzyna update's secant tangent, the capillary force "
+        "semi-implicit), bounded by the heat step only (docs/implicit.md)",
+    )
+    implicit_step_factor: float = Field(
+        100.0,
+        gt=0,
+        description='implicit, dt_s = "auto": this many times the explicit "auto" step, and no '
+        "more than the heat step (heat_step_fraction x the thermal limit)",
+    )
+    newton_tolerance: float = Field(
+        1e-6,
+        gt=0,
+        lt=1,
+        description="implicit: Newton stops when the momentum residual is below this fraction "
+        "of the step's force scale (the norms of inertia, internal, capillary and body forces)",
+    )
+    newton_max_iterations: int = Field(
+        40, ge=1, description="implicit: Newton iterations per step before the step is refused"
+    )
+    implicit_small_mass: float = Field(
+        1e-3,
+        ge=0,
+        lt=1,
+        description="implicit: nodes below this fraction of a full cell's mass rest (the "
+        "explicit step's cut is solver.small_mass): a node that only the edges of the points' "
+        "supports reach has a velocity its equations barely fix, and points nearer to it "
+        "inverted or blew up (docs/implicit.md)",
+    )
+    linear_solver: Literal["auto", "direct", "amg"] = Field(
+        "auto",
+        description="implicit: direct (SuperLU, scipy.sparse), amg (conjugate gradients "
+        "preconditioned by pyamg's smoothed aggregation) or auto (direct up to "
+        "direct_max_unknowns grid velocity components, amg above)",
+    )
+    direct_max_unknowns: int = Field(
+        200_000, ge=1, description='implicit, linear_solver = "auto": the largest direct solve'
+    )
 
 
 class Solver(Model):

@@ -185,6 +185,21 @@ class Case(Model):
                 f"solver.stress_form = {self.solver.stress_form!r}: the printed eq. 39 "
                 '(solver.stress_reading = "paper") exists in the total form only'
             )
+        if (
+            self.time.integrator == "implicit"
+            and self.physics.surface_tension
+            and self.surface_tension.method != "surface_energy"
+        ):
+            raise CaseError(
+                f"surface_tension.method = {self.surface_tension.method!r}: the implicit "
+                "integrator linearises the surface-energy force only (allowed with it: "
+                '"surface_energy")'
+            )
+        if self.time.integrator == "implicit" and self.solver.update != "usl":
+            raise CaseError(
+                f"solver.update = {self.solver.update!r}: the implicit integrator moves the "
+                'points with its converged grid velocity (allowed with it: "usl")'
+            )
         if self.time.stop == "solidified" and self.time.max_s <= self.lasers_off_s():
             raise CaseError(
                 f"time.max_s = {self.time.max_s}: must exceed the time every laser is off "

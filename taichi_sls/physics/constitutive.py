@@ -232,29 +232,72 @@ def solvent_stress(mp: ti.template(), L, xi):
 
 
 @ti.func
+def _finite_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, f, J, dt):
+    """:func:`hencky_update` of point p with its stored state: f = I + dt L (3x3), J = det F
+    after the step."""
+    d_iso = 0.0
+    if ti.static(cfg.th_strain):
+        d_iso = pt.iso_strain_step[p]
+    return hencky_update(
+        mat[pt.material[p]],
+        pt.elastic_stretch[p],
+        pt.stress_phase[p],
+        pt.equivalent_plastic_strain[p],
+        f,
+        d_iso,
+        pt.solid_fraction[p],
+        pt.T[p],
+        J,
+        dt,
+        cfg.plastic,
+        cfg.dim,
+    )
+
+
+@ti.func
+def _incremental_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, deps, dt):
+    """:func:`perzyna_increment` of point p with its stored state, strain increment deps."""
+    d_iso = 0.0
+    if ti.static(cfg.th_strain):
+        d_iso = pt.iso_strain_step[p]
+    return perzyna_increment(
+        mat[pt.material[p]],
+        pt.stress[p],
+        embed3(deps),
+        d_iso,
+        pt.equivalent_plastic_strain[p],
+        pt.solid_fraction[p],
+        pt.T[p],
+        dt,
+        cfg.plastic,
+    )
+
+
+@ti.func
+def _total_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, eps, dt):
+    """:func:`perzyna_update` of point p with its stored state at total strain eps."""
+    return perzyna_update(
+        mat[pt.material[p]],
+        embed3(eps),
+        pt.plastic_strain[p],
+        pt.equivalent_plastic_strain[p],
+        pt.iso_strain[p],
+        pt.solid_fraction[p],
+        pt.T[p],
+        dt,
+        cfg.plastic,
+        cfg.stress_reading,
+    )
+
+
+@ti.func
 def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
     """The stress of point p after a step of velocity gradient L: ``solver.strain`` finite
     (:func:`hencky_update`) or small (:func:`small_strain_update`); with a solvent viscosity
     also its stress (force only)."""
     if ti.static(cfg.strain == Strain.FINITE):
-        d_iso = 0.0
-        if ti.static(cfg.th_strain):
-            d_iso = pt.iso_strain_step[p]
         I3 = ti.Matrix.identity(float, 3)  # f_zz = 1: plane strain
-        sig, Fe, dgam, n = hencky_update(
-            mat[pt.material[p]],
-            pt.elastic_stretch[p],
-            pt.stress_phase[p],
-            pt.equivalent_plastic_strain[p],
-            I3 + dt * to3(L, cfg.dim),
-            d_iso,
-            pt.solid_fraction[p],
-            pt.T[p],
-            pt.J[p],
-            dt,
-            cfg.plastic,
-            cfg.dim,
-        )
+        sig, Fe, dgam, n = _finite_step(cfg, pt, mat, p, I3 + dt * to3(L, cfg.dim), pt.J[p], dt)
         pt.stress[p] = sig
         pt.elastic_stretch[p] = Fe
         pt.stress_phase[p] = pt.solid_fraction[p]
@@ -276,20 +319,7 @@ def small_strain_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(
     which it then touches only where the point yields)."""
     deps = 0.5 * (L + L.transpose()) * dt
     if ti.static(cfg.stress_form == StressForm.INCREMENTAL):
-        d_iso = 0.0
-        if ti.static(cfg.th_strain):
-            d_iso = pt.iso_strain_step[p]
-        sig, dgam, n = perzyna_increment(
-            mat[pt.material[p]],
-            pt.stress[p],
-            embed3(deps),
-            d_iso,
-            pt.equivalent_plastic_strain[p],
-            pt.solid_fraction[p],
-            pt.T[p],
-            dt,
-            cfg.plastic,
-        )
+        sig, dgam, n = _incremental_step(cfg, pt, mat, p, deps, dt)
         pt.stress[p] = sig
         if ti.static(cfg.plastic):
             if dgam > 0.0:
@@ -298,21 +328,51 @@ def small_strain_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(
     else:
         eps = pt.strain[p] + deps
         pt.strain[p] = eps
-        sig, epl, a = perzyna_update(
-            mat[pt.material[p]],
-            embed3(eps),
-            pt.plastic_strain[p],
-            pt.equivalent_plastic_strain[p],
-            pt.iso_strain[p],
-            pt.solid_fraction[p],
-            pt.T[p],
-            dt,
-            cfg.plastic,
-            cfg.stress_reading,
-        )
+        sig, epl, a = _total_step(cfg, pt, mat, p, eps, dt)
         pt.stress[p] = sig
         pt.plastic_strain[p] = epl
         pt.equivalent_plastic_strain[p] = a
+
+
+@ti.func
+def trial_stress(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L, dt):
+    """The stress point p would take after a step of velocity gradient L, without keeping it
+    (the implicit step's residual; :func:`stress_update` keeps the converged one). Returns
+    (sigma, mu_t, K, eta): the in-plane Cauchy stress with the solvent's, the secant shear
+    modulus of the Perzyna return mu |s| / |s_trial| (mu where the step stays elastic; a zero-
+    yield melt at dt >> eta / 2 mu: ~eta / 2 dt, its Newtonian viscosity over dt), the bulk
+    modulus and the solvent viscosity, from which the implicit step builds its tangent."""
+    mp = mat[pt.material[p]]
+    xi = pt.solid_fraction[p]
+    mu, K = bulk_shear(mp, xi)
+    sig3 = ti.Matrix.zero(float, 3, 3)
+    dgam = 0.0
+    kirchhoff = 1.0  # the return map acts on the Kirchhoff deviator J s in finite strain
+    if ti.static(cfg.strain == Strain.FINITE):
+        f = ti.Matrix.identity(float, 3) + dt * to3(L, cfg.dim)
+        J = pt.J[p] * f.determinant()
+        sig3, Fe, dgam, n = _finite_step(cfg, pt, mat, p, f, J, dt)
+        kirchhoff = J
+    else:
+        deps = 0.5 * (L + L.transpose()) * dt
+        if ti.static(cfg.stress_form == StressForm.INCREMENTAL):
+            sig3, dgam, n = _incremental_step(cfg, pt, mat, p, deps, dt)
+        else:
+            sig3, epl, a = _total_step(cfg, pt, mat, p, pt.strain[p] + deps, dt)
+            dgam = (a - pt.equivalent_plastic_strain[p]) / SQRT23
+    ratio = 1.0
+    if dgam > 0.0:
+        tau = kirchhoff * sig3
+        s_norm = (tau - tau.trace() / 3.0 * ti.Matrix.identity(float, 3)).norm()
+        ratio = s_norm / (s_norm + 2.0 * mu * dgam)
+    sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+        sig[a, b] = sig3[a, b]
+    eta = 0.0
+    if ti.static(cfg.solvent):
+        sig += solvent_stress(mp, L, xi)
+        eta = mp.solvent_viscosity_Pa_s * (1.0 - xi)
+    return sig, mu * ratio, K, eta
 
 
 @ti.func
@@ -321,8 +381,15 @@ def thermal_strain_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(
     increment is spread over the heat_every mechanical steps that follow: added at once it is an
     impulse that rings the elastic melt (the scan case's kinetic energy tripled with heat every
     19 steps)."""
+    pt.iso_strain_step[p] = thermal_strain_increment(pt, mat, p, dT, dxi) / cfg.heat_every
+
+
+@ti.func
+def thermal_strain_increment(pt: ti.template(), mat: ti.template(), p, dT, dxi):
+    """The isotropic thermal and solidification strain of one heat step (eqs. 36-37), alpha at
+    the step's mean solid fraction."""
     mp = mat[pt.material[p]]
     alpha = lerp_phase(
         pt.solid_fraction[p] - 0.5 * dxi, mp.expansion_solid_1_K, mp.expansion_liquid_1_K
     )
-    pt.iso_strain_step[p] = (alpha * dT + mp.solidification_dilatation * dxi) / cfg.heat_every
+    return alpha * dT + mp.solidification_dilatation * dxi

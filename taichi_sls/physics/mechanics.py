@@ -53,10 +53,11 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
     vp = pt.v[p]
     Vp = pt.volume0[p] * pt.J[p]
     sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
-    for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
-        sig[a, b] = pt.stress[p][a, b]
-    if ti.static(cfg.solvent):
-        sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
+    if ti.static(not cfg.implicit):  # implicit: the internal force of the new stress instead
+        for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+            sig[a, b] = pt.stress[p][a, b]
+        if ti.static(cfg.solvent):
+            sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
     g = ti.Vector(cfg.gravity, dt=float)
     for o in ti.static(ti.grouped(STENCIL)):
         N, gN = node_weight(w, dw, o)
@@ -66,7 +67,9 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
             mv += pt.C[p] @ (node_x(cfg, I) - xp)
         scatter_add(cfg, nd.mass, I, N * mi)
         scatter_add(cfg, nd.momentum, I, N * mi * mv)
-        f = -Vp * (sig @ gN)
+        f = ti.Vector.zero(float, cfg.dim)
+        if ti.static(not cfg.implicit):
+            f = -Vp * (sig @ gN)
         if ti.static(cfg.has_gravity):
             f += N * mp * g
         scatter_add(cfg, nd.force, I, f)
@@ -141,11 +144,8 @@ def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
 
 
 @ti.func
-def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw, dt):
-    """Position (eq. 15), velocity gradient, F (eq. 17) and J (eq. 18) from the grid velocity.
-
-    Returns the velocity gradient L for the constitutive update.
-    """
+def interpolate_velocity(cfg: ti.template(), nd: ti.template(), base, w, dw):
+    """The grid velocity at a point and its gradient L = sum_i v_i grad N_i (eq. 16)."""
     v_grid = ti.Vector.zero(float, cfg.dim)
     L = ti.Matrix.zero(float, cfg.dim, cfg.dim)
     for o in ti.static(ti.grouped(STENCIL)):
@@ -153,6 +153,16 @@ def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
         vi = nd.v[base + o]
         v_grid += N * vi
         L += vi.outer_product(gN)
+    return v_grid, L
+
+
+@ti.func
+def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw, dt):
+    """Position (eq. 15), velocity gradient, F (eq. 17) and J (eq. 18) from the grid velocity.
+
+    Returns the velocity gradient L for the constitutive update.
+    """
+    v_grid, L = interpolate_velocity(cfg, nd, base, w, dw)
     pt.x[p] += dt * v_grid
     F = (ti.Matrix.identity(float, cfg.dim) + dt * L) @ pt.F[p]
     pt.F[p] = F

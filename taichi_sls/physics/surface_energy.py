@@ -142,13 +142,16 @@ def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()
 
 
 @ti.func
-def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), t):
-    """The outline of the colour field and its surface-energy force, added to nd.force."""
-    if ti.static(cfg.se.spread):
-        for I in ti.grouped(ti.ndrange(*active(box))):
-            nd.surface_force[I] = ti.Vector.zero(float, 2)
-    colour_field(cfg, box, nd)
-    gamma = ramped_gamma(cfg, t)
+def outline_segments(
+    cfg: ti.template(),
+    box: ti.template(),
+    nd: ti.template(),
+    visit: ti.template(),
+    target: ti.template(),
+    scale,
+):
+    """visit(cfg, target, a, b, scale) for every segment a-b of the c = 1/2 contour of
+    nd.colour, cell by cell (marching squares)."""
     for i, j in ti.ndrange(*active(box, 1)):
         if i > 0 and j > 0 and i < cfg.nx - 2 and j < cfg.ny - 2:
             f = C_INTERFACE - ti.Vector(
@@ -160,6 +163,16 @@ def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template
                 for k in range(count):
                     a = ti.Vector([ends[4 * k], ends[4 * k + 1]])
                     b = ti.Vector([ends[4 * k + 2], ends[4 * k + 3]])
-                    segment_force(cfg, nd, a, b, gamma)
+                    visit(cfg, target, a, b, scale)
+
+
+@ti.func
+def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), t):
+    """The outline of the colour field and its surface-energy force, added to nd.force."""
+    if ti.static(cfg.se.spread):
+        for I in ti.grouped(ti.ndrange(*active(box))):
+            nd.surface_force[I] = ti.Vector.zero(float, 2)
+    colour_field(cfg, box, nd)
+    outline_segments(cfg, box, nd, segment_force, nd, ramped_gamma(cfg, t))
     if ti.static(cfg.se.spread):
         spread_light_nodes(cfg, box, nd)

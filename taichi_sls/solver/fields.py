@@ -18,7 +18,8 @@ Nodes (``nodes``, the grid of ``nx x ny``):
   distance), phi_smooth, kappa, scratch, flags (NodeFlag bits) and mass_gradient (eq. 20); the
   surface-energy method's volume (the volume colour), colour (the contoured one) and
   surface_force (before the mass floor).
-Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, laser_energy,
+Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, dt_heat (the heat
+  substep of the implicit step), laser_energy,
   heat_out (heat through fixed-temperature walls), T_peak (running maximum), and for each of
   WATCHED the first step at which a point showed it (NEVER if none), so that the guard, which
   looks once per frame, can name what broke first.
@@ -32,6 +33,7 @@ from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix
 from ..physics.laser import laser_struct
 from ..physics.materials import KELVIN, enthalpy, material_struct, solid_fraction
+from ..physics.stiffness import WIDTH
 from .scene import Scene
 from .step_config import StepConfig
 
@@ -133,6 +135,23 @@ class SurfaceScratch:
 
 
 @ti.data_oriented
+class ImplicitFields:
+    """The implicit step's grid data (solver/implicit.py, physics/stiffness.py): the fixed part
+    of its matrix (inertia, capillary stiffness) and the points' tangent, both as node i's row
+    over the WIDTH^dim nodes around it; the internal force; which velocity components are free
+    (1) and their unknown's index (-1: none)."""
+
+    def __init__(self, cfg: StepConfig) -> None:
+        grid = (cfg.nx, cfg.ny)
+        rows = grid + (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim)
+        self.fixed = ti.field(float, rows)
+        self.tangent = ti.field(float, rows)
+        self.internal = ti.Vector.field(cfg.dim, float, grid)
+        self.free = ti.Vector.field(cfg.dim, ti.i32, grid)
+        self.dof = ti.Vector.field(cfg.dim, ti.i32, grid)
+
+
+@ti.data_oriented
 class State:
     """Every field of a run; ``cfg`` (StepConfig) is the compile-time configuration."""
 
@@ -157,6 +176,7 @@ class State:
             t=float,
             step=ti.i32,
             dt=float,
+            dt_heat=float,
             laser_energy=float,
             heat_out=float,
             T_peak=float,
@@ -168,6 +188,7 @@ class State:
         self.surf = SurfaceScratch(cfg.nx, cfg.ny)
         self.box = ti.Vector.field(4, ti.i32, ())  # active region [i0, j0, i1, j1)
         self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())
+        self.implicit = ImplicitFields(cfg) if cfg.implicit else None
         self._fill(materials, lasers)
 
     @property

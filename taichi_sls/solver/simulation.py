@@ -17,12 +17,19 @@ from .blocks import BlockPlan
 from .contacts import neck_width, point_colour, touching
 from .fields import State
 from .guard import Guard
+from .implicit import ImplicitStepper
 from .monitor import neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
 from .step import advance, colour_only, init_box, level_set_only
 from .step_config import Layout, choose_layout, step_config
-from .time_step import resolve_curvature_every, resolve_dt, resolve_heat_every
+from .time_step import (
+    resolve_curvature_every,
+    resolve_dt,
+    resolve_heat_every,
+    resolve_heat_substeps,
+    time_step_limits,
+)
 
 
 def init_taichi(
@@ -80,21 +87,32 @@ class Simulation:
             self.blocks = BlockPlan(self.scene.nx, self.scene.ny, h, off)
             self.scene = self.scene.reordered(self.blocks.order(self.scene.x))
             self.blocks.set_ranges(self.scene.x)
+        # the implicit step's heat substeps (0: no heat, or the explicit step)
+        implicit = case.time.integrator == "implicit" and case.physics.mechanics
+        self.heat_substeps = resolve_heat_substeps(case, self.dt) if implicit else 0
         cfg = step_config(
             case,
             self.scene,
             self.heat_every,
             self.curvature_every,
             self.dt,
-            self.dt_limits.get("thermal", math.inf),
+            time_step_limits(case).get("thermal", math.inf)
+            if implicit
+            else self.dt_limits.get("thermal", math.inf),
+            self.dt / max(self.heat_substeps, 1),
         )
         mats = material_arrays(case, self.scene.material_names)
         self.state = State(cfg, self.scene, mats, laser_arrays(case), self.blocks)
         self.state.scalars.dt[None] = self.dt
         init_box(self.state)
         self.steps = 0
+        self.implicit = None
+        if cfg.implicit:
+            self.state.scalars.dt_heat[None] = self.dt / max(self.heat_substeps, 1)
+            self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
         t0 = time.perf_counter()
-        advance(self.state, 0)  # compiles the step kernel
+        if self.implicit is None:
+            advance(self.state, 0)  # compiles the step kernel
         self.compile_s = time.perf_counter() - t0
         self._mass = self.state.points.mass.to_numpy()
         # each point's index in the order the run started with: the blocks layout sorts the
@@ -128,17 +146,18 @@ class Simulation:
         """Advance n steps."""
         if n <= 0:
             return
+        step = advance if self.implicit is None else lambda st, k: self.implicit.advance(k)
         if self.before_step is not None:
             for _ in range(n):
                 self.before_step(self)
-                advance(self.state, 1)
+                step(self.state, 1)
         elif self.blocks is not None:
             for _ in range(n):  # a point that drifted out of its block: sort them again
-                advance(self.state, 1)
+                step(self.state, 1)
                 if self.blocks.needs_sort[None]:
                     self.sort_points()
         else:
-            advance(self.state, n)
+            step(self.state, n)
         self.steps += n
 
     def sort_points(self) -> None:

@@ -28,7 +28,7 @@ loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
 import taichi as ti
 
 from ..physics.codes import SurfaceMethod, Update
-from ..physics.constitutive import stress_update, thermal_strain_step
+from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
 from ..physics.level_set import level_set, scatter_level_set
@@ -186,8 +186,20 @@ def _csf_mass(st: ti.template()):
 
 
 @ti.func
+def heat_step(st: ti.template()):
+    """The heat step: heat_every mechanical steps; implicit: the step over its heat substeps
+    (solver/implicit.py)."""
+    dt_heat = 0.0
+    if ti.static(st.cfg.implicit):
+        dt_heat = st.scalars.dt_heat[None]
+    else:
+        dt_heat = st.scalars.dt[None] * st.cfg.heat_every
+    return dt_heat
+
+
+@ti.func
 def _heat_flux_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    dt_heat = st.scalars.dt[None] * st.cfg.heat_every
+    dt_heat = heat_step(st)
     t = st.scalars.t[None]
     pt = ti.static(st.points)
     base, w, dw = point_stencil(st.cfg, pt, p)
@@ -210,9 +222,9 @@ def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
 @ti.func
 def grid_update(st: ti.template(), heat: ti.template(), geom: ti.template()):
     dt = st.scalars.dt[None]
-    dt_heat = dt * st.cfg.heat_every
+    dt_heat = heat_step(st)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(st.cfg.mech):
+        if ti.static(st.cfg.mech and not st.cfg.implicit):
             grid_velocity(st.cfg, st.nodes, I, dt)
         if ti.static(st.cfg.thermal):
             if heat:
@@ -225,6 +237,13 @@ def g2p_point(
 ):
     """Heat, thermal strains and velocity of point p; with ``kinematics`` (USL) also its motion
     and stress."""
+    g2p_point_heat(st, p, blk, base, w, dw, dt, heat)
+    g2p_point_mechanics(st, p, base, w, dw, dt, kinematics)
+
+
+@ti.func
+def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template()):
+    """Heat (eqs. 32-33) and the thermal strain increment of point p."""
     pt, nd, mat = ti.static(st.points, st.nodes, st.materials)
     if ti.static(st.cfg.thermal):
         if heat:
@@ -233,11 +252,25 @@ def g2p_point(
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
             if pt.solid_fraction[p] == 0.0:  # above T_m for this heat step
-                pt.time_molten[p] += dt * st.cfg.heat_every
+                if ti.static(st.cfg.implicit):
+                    pt.time_molten[p] += st.scalars.dt_heat[None]
+                else:
+                    pt.time_molten[p] += dt * st.cfg.heat_every
             if ti.static(st.cfg.th_strain and st.cfg.mech):
-                thermal_strain_step(st.cfg, pt, mat, p, dT, dxi)
-        if ti.static(st.cfg.th_strain and st.cfg.mech):
+                if ti.static(st.cfg.implicit):  # the step's strain: the sum over its substeps
+                    inc = thermal_strain_increment(pt, mat, p, dT, dxi)
+                    pt.iso_strain_step[p] += inc
+                    pt.iso_strain[p] += inc
+                else:
+                    thermal_strain_step(st.cfg, pt, mat, p, dT, dxi)
+        if ti.static(st.cfg.th_strain and st.cfg.mech and not st.cfg.implicit):
             pt.iso_strain[p] += pt.iso_strain_step[p]
+
+
+@ti.func
+def g2p_point_mechanics(st: ti.template(), p, base, w, dw, dt, kinematics: ti.template()):
+    """Velocity of point p; with ``kinematics`` (USL) also its motion and stress."""
+    pt, nd, mat = ti.static(st.points, st.nodes, st.materials)
     if ti.static(st.cfg.mech):
         g2p_velocity(st.cfg, pt, nd, p, base, w, dw)
         if ti.static(kinematics):

@@ -81,6 +81,7 @@ class StepConfig:
     transfer: Transfer
     flip_ratio: float
     update: Update
+    implicit: bool  # time.integrator = "implicit" (solver/implicit.py)
     layout: Layout
     parallel: bool  # one kernel call per step, its loops parallel (not the serial layout)
     race_free: bool  # the layout keeps scattering threads apart: plain adds (blocks)
@@ -151,8 +152,10 @@ def step_config(
     curvature_every: int,
     dt: float = 0.0,
     thermal_limit: float = math.inf,
+    heat_dt: float = 0.0,
 ) -> StepConfig:
-    """The configuration of ``case`` on ``scene`` with the resolved time step and clocks."""
+    """The configuration of ``case`` on ``scene`` with the resolved time step and clocks
+    (``heat_dt``: the implicit step's heat substep)."""
     ph, st, sv = case.physics, case.surface_tension, case.solver
     walls = case.boundary.walls()
     h = scene.h
@@ -164,6 +167,7 @@ def step_config(
     rho_ref = first.density_kg_m3 * sv.mass_scale
     layout = choose_layout(case, scene.n_points)
     floor = st.surface_energy_mass_floor * rho_ref * h**2
+    implicit = case.time.integrator == "implicit" and ph.mechanics
     return StepConfig(
         dim=2,
         n_points=scene.n_points,
@@ -193,6 +197,7 @@ def step_config(
         transfer=Transfer[sv.transfer.upper()],
         flip_ratio=flip_share(case, dt),
         update=Update[sv.update.upper()],
+        implicit=implicit,
         layout=layout,
         parallel=layout != Layout.SERIAL,
         race_free=layout == Layout.BLOCKS,
@@ -209,7 +214,11 @@ def step_config(
         wall_T=tuple(w.temperature_C + KELVIN for w in walls),
         any_fixed=thermal and any(w.thermal == "fixed" for w in walls),
         # the filter's fraction per heat step, from its rate per thermal limit
-        subgrid_filter=-math.expm1(-case.thermal.subgrid_filter * dt * heat_every / thermal_limit)
+        subgrid_filter=(
+            -math.expm1(-case.thermal.subgrid_filter * heat_dt / thermal_limit)
+            if implicit
+            else -math.expm1(-case.thermal.subgrid_filter * dt * heat_every / thermal_limit)
+        )
         if thermal
         else 0.0,
         hysteresis=thermal
@@ -228,7 +237,10 @@ def step_config(
         gamma_ramp_s=st.ramp_s,
         mass_scale=sv.mass_scale,
         rho_ref=rho_ref,
-        mass_cut=sv.small_mass * first.density_kg_m3 * sv.mass_scale * h**2,
+        mass_cut=(case.time.implicit_small_mass if implicit else sv.small_mass)
+        * first.density_kg_m3
+        * sv.mass_scale
+        * h**2,
         gamma=first.surface_tension_N_m,
         r_p=st.point_radius_over_h * h,
         band=st.band_cells,

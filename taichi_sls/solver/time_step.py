@@ -37,6 +37,8 @@ def resolve_dt(case: Case) -> tuple[float, dict[str, float]]:
     thermal limit can be the smallest, and a heat step near it overshoots); a fixed dt above the
     smallest limit is refused unless ``time.allow_unstable_dt``."""
     limits = time_step_limits(case)
+    if case.time.integrator == "implicit" and case.physics.mechanics:
+        return _implicit_dt(case, limits)
     bound = min(limits.values()) if limits else case.time.end_s
     if case.time.dt_s == "auto":
         dt = case.time.safety * bound
@@ -52,6 +54,25 @@ def resolve_dt(case: Case) -> tuple[float, dict[str, float]]:
             f'dt, "auto", or time.allow_unstable_dt = true'
         )
     return dt, limits
+
+
+def _implicit_dt(case: Case, explicit: dict[str, float]) -> tuple[float, dict[str, float]]:
+    """The implicit step, which no limit bounds (the heat takes substeps,
+    :func:`resolve_heat_substeps`): "auto" is ``time.implicit_step_factor`` times the explicit
+    "auto" step."""
+    t = case.time
+    if t.dt_s == "auto":
+        return t.implicit_step_factor * t.safety * min(explicit.values(), default=t.end_s), {}
+    return float(t.dt_s), {}
+
+
+def resolve_heat_substeps(case: Case, dt: float) -> int:
+    """Heat substeps per implicit step: the fewest whose step is at most ``heat_step_fraction``
+    of the thermal limit (0 without heat)."""
+    limits = time_step_limits(case)
+    if "thermal" not in limits:
+        return 0
+    return max(1, math.ceil(dt / (case.time.heat_step_fraction * limits["thermal"]) - 1e-9))
 
 
 def _every(
@@ -72,7 +93,7 @@ def resolve_heat_every(case: Case, dt: float, limits: dict[str, float]) -> int:
     """Mechanical steps per heat step. Conduction is explicit with a limit ~100x the elastic
     one (paper's fine grid: 9.8e-6 s against 1.3e-7 s), so the heat update runs on its own,
     slower clock; "auto" keeps its step at ``heat_step_fraction`` of the thermal limit."""
-    if not case.physics.thermal:
+    if not case.physics.thermal or (case.time.integrator == "implicit" and case.physics.mechanics):
         return 1
     t = case.time
     lim = limits.get("thermal", math.inf)

@@ -1,0 +1,113 @@
+"""The tangent of the implicit step's momentum balance on the grid (solver/implicit.py).
+
+Backward Euler for the grid velocities v_i^{n+1}:
+
+    m_i (v_i - v_i^n) / dt = f_i^ext + f_i^cap(x^n) - dt (K^cap v)_i + f_i^int(v)
+
+f^int is the internal force of the stress each point takes after the step (its Perzyna update
+with L = sum_j v_j grad N_j). Newton's tangent of -f^int is assembled from each point's linear
+isotropic law, delta sigma = a_lambda tr(delta D) 1 + 2 a_mu delta D with delta D = sym(delta L):
+
+    K_ij^ab = V_p [a_lambda dN_i/dx_a dN_j/dx_b + a_mu (dN_i/dx_b dN_j/dx_a + delta_ab grad N_i .
+              grad N_j)],   a_lambda = dt (K - 2 mu_t / 3) - 2 eta / 3,  a_mu = dt mu_t + eta
+
+with mu_t the secant shear modulus of the return map and eta the solvent viscosity
+(physics/constitutive.py, trial_stress): symmetric and positive definite while K + mu_t / 3 > 0.
+K^cap is the semi-implicit capillary stiffness of Baensch (2001) and Hysing (2006) on the
+surface-energy outline, the surface Laplacian gamma sum_q w_q L_q (t . grad N_i)(t . grad N_j) 1
+over the Gauss points of its segments (physics/surface_energy.py): the force at x^n + dt v to
+first order, which lifts the capillary step limit.
+
+A point couples the nodes of its 3^dim stencil, so node i's row holds the 5^dim nodes within two
+of it: the matrix lives on the grid as ``K[I, I_j - I_i + 2, a, b]`` and solver/implicit.py
+gathers it into a sparse matrix.
+"""
+
+import taichi as ti
+
+from .shape import STENCIL, node_weight, stencil
+from .surface_energy import GAUSS, outline_segments
+
+REACH = 2  # nodes of one row lie within REACH of the diagonal node along every axis
+WIDTH = 2 * REACH + 1
+
+
+@ti.func
+def stencil_gradients(w, dw):
+    """grad N of the 3^dim stencil nodes, one row per node in STENCIL order (static offsets):
+    the pair loops below run over them at run time, so that they compile as one loop body
+    instead of 81 unrolled ones."""
+    dim = ti.static(w.m)
+    G = ti.Matrix.zero(float, 3**dim, dim)
+    for k, o in ti.static(enumerate(ti.grouped(STENCIL))):
+        N, g = node_weight(w, dw, o)
+        for d in ti.static(range(dim)):
+            G[k, d] = g[d]
+    return G
+
+
+@ti.func
+def stencil_offset(k, dim: ti.template(), side: ti.template() = 3):
+    """The offset of node k of a block of side^dim nodes, the last axis fastest (STENCIL's
+    order for side 3; a matrix row's nodes for side WIDTH)."""
+    o = ti.Vector.zero(ti.i32, dim)
+    r = k
+    for d in ti.static(range(dim - 1, -1, -1)):
+        o[d] = r % side
+        r //= side
+    return o
+
+
+@ti.func
+def scatter_point_tangent(cfg: ti.template(), K: ti.template(), base, w, dw, V, a_lam, a_mu):
+    """K_ij += the tangent of one point (module docstring) over its stencil's node pairs."""
+    G = stencil_gradients(w, dw)
+    for i in range(3**cfg.dim):
+        oi = stencil_offset(i, cfg.dim)
+        for j in range(3**cfg.dim):
+            d = stencil_offset(j, cfg.dim) - oi + REACH
+            gg = 0.0
+            for c in ti.static(range(cfg.dim)):
+                gg += G[i, c] * G[j, c]
+            for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+                k = a_lam * G[i, a] * G[j, b] + a_mu * G[i, b] * G[j, a]
+                if ti.static(a == b):
+                    k += a_mu * gg
+                K[base + oi, d, a, b] += V * k
+
+
+@ti.func
+def scatter_mass(cfg: ti.template(), K: ti.template(), I, m_over_dt):
+    """The inertia m_i / dt on node i's diagonal."""
+    for a in ti.static(range(cfg.dim)):
+        K[I, ti.Vector([REACH] * cfg.dim), a, a] += m_over_dt
+
+
+@ti.func
+def segment_tangent(cfg: ti.template(), K: ti.template(), a, b, scale):
+    """K_ij += scale w_q L (t . grad N_i)(t . grad N_j) 1 over the Gauss points of segment a-b
+    (the surface Laplacian of the outline; scale = dt gamma)."""
+    d = b - a
+    L = d.norm()
+    if L > 0.0:
+        t = d / L
+        s, wq = ti.static(GAUSS[cfg.se.gauss_points])
+        for g in ti.static(range(len(s))):
+            xq = a + s[g] * d
+            base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
+            tg = stencil_gradients(w, dw) @ t  # t . grad N of each stencil node
+            for i in range(3**cfg.dim):
+                oi = stencil_offset(i, cfg.dim)
+                for j in range(3**cfg.dim):
+                    k = scale * wq[g] * L * tg[i] * tg[j]
+                    off = stencil_offset(j, cfg.dim) - oi + REACH
+                    for c in ti.static(range(cfg.dim)):
+                        K[base + oi, off, c, c] += k
+
+
+@ti.func
+def capillary_tangent(
+    cfg: ti.template(), box: ti.template(), nd: ti.template(), K: ti.template(), scale
+):
+    """The capillary stiffness of the outline of nd.colour (the force computed it before)."""
+    outline_segments(cfg, box, nd, segment_tangent, K, scale)

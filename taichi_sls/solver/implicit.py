@@ -1,0 +1,398 @@
+"""The implicit step (``time.integrator = "implicit"``): backward Euler for the grid velocities.
+
+One step, over the explicit step's stages (solver/step.py) where they are the same physics:
+
+    heat       heat_substeps explicit heat steps of dt / heat_substeps (clear_grid, p2g, grid
+               temperature, heat flux, grid heat, the points' heat and thermal strain, summed
+               over the substeps), the points where the step starts: the mechanics of the step
+               sees its thermal strain; the heat keeps its own stability limit
+    begin      clear_grid, p2g (mass, momentum, body force; no stress force), surface force at
+               x^n; the inertia m_i / dt and the capillary stiffness (physics/stiffness.py); v^n
+    Newton     R(v) = (m / dt + dt K^cap) v - (m v^n / dt + f^ext + f^cap) - f^int(v) = 0 over
+               the grid velocity components that are free (node mass above the cut-off, walls
+               removed): f^int from each point's Perzyna update with L(v) (not kept), the
+               tangent from its secant moduli; a sparse solve per iteration and a backtracking
+               line search on |R|
+    end        g2p with the converged v (velocity transfer, motion, the stress kept), watch,
+               the active region, the clock
+
+The internal force of the new stress is taken on the configuration at t^n, where the shape
+functions are evaluated: f_i = -V_p^n P grad N_i(x_p^n) with the first Piola stress of the step
+P = det(f) sigma f^-T, f = I + dt L (exact for the shape functions' own deformation).
+
+Linear solver (``time.linear_solver``, solver/linear_solve.py): an LDL^T factorization up to
+``direct_max_unknowns``, else pyamg's smoothed aggregation, either kept as the preconditioner of
+conjugate gradients over the next iterations and steps. The matrix is symmetric positive definite
+(physics/stiffness.py).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import taichi as ti
+
+from ..config import Case
+from ..physics.codes import SurfaceMethod
+from ..physics.constitutive import trial_stress
+from ..physics.grid import active, ramped_gamma
+from ..physics.mechanics import apply_walls, interpolate_velocity
+from ..physics.shape import STENCIL, node_weight
+from ..physics.stiffness import (
+    REACH,
+    WIDTH,
+    capillary_tangent,
+    scatter_mass,
+    scatter_point_tangent,
+    stencil_offset,
+)
+from .fields import State
+from .linear_solve import LinearSolver
+from .loops import check_block, grow_box, point_loop
+from .step import (
+    advance_clock,
+    clear_grid,
+    g2p_point_heat,
+    g2p_point_mechanics,
+    grid_temperature_stage,
+    grid_update,
+    heat_flux,
+    p2g,
+    point_stencil,
+    surface_force,
+    watch,
+)
+
+# the stages of the explicit step that the implicit one runs: for a heat substep, and (without
+# heat) before its Newton loop
+HEAT_STAGES = (clear_grid, p2g, grid_temperature_stage, heat_flux, grid_update)
+BEFORE = (clear_grid, p2g, surface_force)
+LINE_SEARCH_HALVINGS = 8
+# the relative residual of a Newton step's linear solve (an inexact Newton direction: the
+# iteration itself drives the momentum residual to time.newton_tolerance)
+LINEAR_RTOL = 1e-6
+
+
+class NewtonError(RuntimeError):
+    """The implicit step did not converge: the message gives the residual and what to try."""
+
+
+@dataclass
+class StepReport:
+    """What the last implicit step did: Newton iterations, unknowns, relative residual."""
+
+    iterations: int = 0
+    unknowns: int = 0
+    residual: float = 0.0
+    solver: str = ""
+
+
+# ----------------------------------------------------------------------------- kernels
+@ti.func
+def _heat_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    g2p_point_heat(st, p, blk, base, w, dw, st.scalars.dt[None], heat)
+
+
+@ti.func
+def _clear_matrix(K: ti.template(), I, dim: ti.template()):
+    for r in range(WIDTH**dim):
+        o = stencil_offset(r, dim, WIDTH)
+        for a, b in ti.static(ti.ndrange(dim, dim)):
+            K[I, o, a, b] = 0.0
+
+
+@ti.kernel
+def heat_substep(st: ti.template()):
+    """One heat substep: the explicit step's heat stages (eqs. 28-33) over dt_heat, with the
+    points where they are at the start of the step."""
+    if ti.static(st.cfg.parallel):
+        _heat_substep(st)
+    else:  # the serial layout: every loop in order, so that a run repeats bit for bit
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            _heat_substep(st)
+
+
+@ti.func
+def _heat_substep(st: ti.template()):
+    for stage in ti.static(HEAT_STAGES):
+        stage(st, True, False)
+    point_loop(st, _heat_body, True, False, False)
+
+
+@ti.kernel
+def begin(st: ti.template()):
+    """Everything of the step before the Newton loop (module docstring)."""
+    if ti.static(st.cfg.parallel):
+        _begin(st)
+    else:
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            _begin(st)
+
+
+@ti.func
+def _begin(st: ti.template()):
+    for stage in ti.static(BEFORE):
+        stage(st, False, True)
+    nd = ti.static(st.nodes)
+    dt = st.scalars.dt[None]
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
+        m = nd.mass[I]
+        vn = ti.Vector.zero(float, st.cfg.dim)
+        free = ti.Vector.zero(ti.i32, st.cfg.dim)
+        if m > st.cfg.mass_cut:
+            vn = nd.momentum[I] / m
+            free = ti.cast(apply_walls(st.cfg, I, ti.Vector.one(float, st.cfg.dim)), ti.i32)
+            scatter_mass(st.cfg, st.implicit.fixed, I, m / dt)
+        nd.v_old[I] = vn
+        nd.v[I] = vn * ti.cast(free, float)
+        st.implicit.free[I] = free
+    if ti.static(st.cfg.surface and st.cfg.surface_method == SurfaceMethod.SURFACE_ENERGY):
+        # nd.colour is the one the surface force contoured
+        capillary_tangent(
+            st.cfg, st.box, nd, st.implicit.fixed, dt * ramped_gamma(st.cfg, st.scalars.t[None])
+        )
+
+
+@ti.func
+def _internal_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    """Point p's internal force of its trial stress and its tangent, at the grid velocity."""
+    pt = ti.static(st.points)
+    dt = st.scalars.dt[None]
+    base, w, dw = point_stencil(st.cfg, pt, p)
+    v_grid, L = interpolate_velocity(st.cfg, st.nodes, base, w, dw)
+    sig, mu_t, K, eta = trial_stress(st.cfg, pt, st.materials, p, L, dt)
+    V = pt.volume0[p] * pt.J[p]
+    for o in ti.static(ti.grouped(STENCIL)):
+        N, gN = node_weight(w, dw, o)
+        st.implicit.internal[base + o] += -V * (sig @ gN)
+    a_lam = dt * (K - 2.0 * mu_t / 3.0) - 2.0 * eta / 3.0
+    a_mu = dt * mu_t + eta
+    scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
+
+
+@ti.kernel
+def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.ndarray()):
+    """The grid velocity from the unknowns v, then f^int(v) and the points' tangent."""
+    if ti.static(st.cfg.parallel):
+        _internal_force(st, v, dof_node)
+    else:
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            _internal_force(st, v, dof_node)
+
+
+@ti.func
+def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
+    nd = ti.static(st.nodes)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
+        st.implicit.internal[I] = ti.Vector.zero(float, st.cfg.dim)
+        nd.v[I] = ti.Vector.zero(float, st.cfg.dim)
+    for k in range(v.shape[0]):
+        nd.v[dof_node[k, 0], dof_node[k, 1]][dof_node[k, 2]] = v[k]
+    point_loop(st, _internal_body, False, False, True)
+
+
+@ti.kernel
+def gather(
+    st: ti.template(),
+    K: ti.template(),
+    dof_node: ti.types.ndarray(),
+    cols: ti.types.ndarray(),
+    vals: ti.types.ndarray(),
+    vec: ti.types.ndarray(),
+    guess: ti.types.ndarray(),
+    fixed: ti.template(),
+):
+    """Row k of matrix K (the WIDTH^dim x dim slots of node-component k; cols -1 where the
+    neighbour's component is not an unknown) and, ``fixed``: the columns, the right-hand side
+    m v^n / dt + f into vec and v^n into guess; else: the internal force into vec."""
+    nd = ti.static(st.nodes)
+    for k in range(vals.shape[0]):
+        I = ti.Vector([dof_node[k, 0], dof_node[k, 1]])
+        a = dof_node[k, 2]
+        for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
+            o = stencil_offset(r, st.cfg.dim, WIDTH)
+            J = I + o - REACH
+            inside = (J >= 0).all() and (J < ti.Vector([st.cfg.nx, st.cfg.ny])).all()
+            for b in ti.static(range(st.cfg.dim)):
+                slot = r * st.cfg.dim + b
+                c = -1
+                if inside:
+                    c = st.implicit.dof[J][b]
+                value = 0.0
+                if c >= 0:
+                    value = K[I, o, a, b]
+                vals[k, slot] = value
+                if ti.static(fixed):
+                    cols[k, slot] = c
+        if ti.static(fixed):
+            vec[k] = nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]
+            guess[k] = nd.v[I][a]
+        else:
+            vec[k] = st.implicit.internal[I][a]
+
+
+@ti.func
+def _end_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    g2p_point_mechanics(st, p, base, w, dw, st.scalars.dt[None], True)
+    if ti.static(st.cfg.th_strain):
+        st.points.iso_strain_step[p] = 0.0  # the next step sums its substeps' strain afresh
+    watch(st, p)
+    grow_box(st, blk, p)
+    check_block(st, blk, p)
+
+
+@ti.kernel
+def end(st: ti.template()):
+    """The converged grid velocity to the points: velocity, motion and the kept stress."""
+    point_loop(st, _end_body, True, True, False)  # each point writes its own state only
+    advance_clock(st, True, True)
+
+
+# ----------------------------------------------------------------------------- linear solve
+def linear_solver(case: Case, n: int) -> str:
+    """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
+    choice = case.time.linear_solver
+    if choice == "auto":
+        choice = "direct" if n <= case.time.direct_max_unknowns else "amg"
+    return choice
+
+
+# ----------------------------------------------------------------------------- the step
+@dataclass
+class GridSystem:
+    """One step's unknowns and the fixed part of its matrix. Unknown k is velocity component
+    ``dof_node[k, 2]`` of node ``dof_node[k, :2]``; ``slots`` picks the stored entries of the
+    WIDTH^dim x dim slots of each row (the neighbours' components that are unknowns too), which
+    ``indices`` and ``indptr`` lay out as a CSR matrix (columns sorted: unknowns are numbered
+    node by node in index order, and the slots run the same way)."""
+
+    dof_node: np.ndarray
+    slots: np.ndarray
+    indices: np.ndarray
+    indptr: np.ndarray
+    fixed: np.ndarray  # inertia and capillary stiffness, on the stored entries
+    rhs: np.ndarray  # m v^n / dt + f^ext + f^cap
+    v0: np.ndarray  # v^n (walls applied): Newton's first iterate
+
+    @property
+    def n(self) -> int:
+        return len(self.rhs)
+
+    def matrix(self, values: np.ndarray) -> sp.csr_matrix:
+        A = sp.csr_matrix((values, self.indices, self.indptr), shape=(self.n, self.n))
+        A.has_sorted_indices = True
+        return A
+
+
+class ImplicitStepper:
+    """Backward-Euler steps of one State (module docstring)."""
+
+    def __init__(self, case: Case, st: State, heat_substeps: int) -> None:
+        self.case = case
+        self.st = st
+        self.heat_substeps = heat_substeps if st.cfg.thermal else 0
+        self.tol = case.time.newton_tolerance
+        self.max_iterations = case.time.newton_max_iterations
+        self.last = StepReport()
+        self.newton_total = 0
+        self.linear: LinearSolver | None = None
+        self._slots = WIDTH**st.cfg.dim * st.cfg.dim
+
+    def advance(self, n: int) -> None:
+        for _ in range(n):
+            self.step()
+
+    def step(self) -> None:
+        sys_ = self.prepare()
+        if sys_.n:
+            self.newton(sys_)
+        else:
+            self.last = StepReport()
+        end(self.st)
+
+    def prepare(self) -> GridSystem:
+        """The step up to its Newton loop: ``begin``, the unknowns, the fixed matrix."""
+        st = self.st
+        if self.heat_substeps:
+            t0 = float(st.scalars.t[None])
+            dt_heat = float(st.scalars.dt_heat[None])
+            for k in range(self.heat_substeps):
+                st.scalars.t[None] = t0 + k * dt_heat
+                heat_substep(st)
+            st.scalars.t[None] = t0
+        begin(st)
+        free = st.implicit.free.to_numpy()
+        flat = free.reshape(-1) != 0
+        dof = np.full(flat.shape, -1, dtype=np.int32)
+        n = int(flat.sum())
+        dof[flat] = np.arange(n, dtype=np.int32)
+        st.implicit.dof.from_numpy(dof.reshape(free.shape))
+        dof_node = np.ascontiguousarray(np.argwhere(free != 0).astype(np.int32))
+        cols = np.empty((n, self._slots), dtype=np.int32)
+        fixed = np.empty((n, self._slots))
+        rhs, v0 = np.empty(n), np.empty(n)
+        if n:
+            gather(st, st.implicit.fixed, dof_node, cols, fixed, rhs, v0, True)
+        slots = cols >= 0
+        indptr = np.concatenate([[0], np.cumsum(slots.sum(axis=1))])
+        return GridSystem(dof_node, slots, cols[slots], indptr, fixed[slots], rhs, v0)
+
+    def internal(self, sys_: GridSystem, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """f^int(v) at the unknowns and the points' tangent on the stored entries."""
+        st = self.st
+        internal_force(st, v, sys_.dof_node)
+        vals = np.empty((sys_.n, self._slots))
+        f_int = np.empty(sys_.n)
+        unused = np.empty((1, 1), dtype=np.int32)
+        gather(st, st.implicit.tangent, sys_.dof_node, unused, vals, f_int, f_int, False)
+        return f_int, vals[sys_.slots]
+
+    @staticmethod
+    def residual(sys_: GridSystem, v: np.ndarray, f_int: np.ndarray) -> tuple[np.ndarray, float]:
+        """R(v) and the force scale it is measured against (module docstring)."""
+        Av = sys_.matrix(sys_.fixed) @ v
+        R = Av - sys_.rhs - f_int
+        scale = max(np.linalg.norm(Av) + np.linalg.norm(sys_.rhs) + np.linalg.norm(f_int), 1e-300)
+        return R, scale
+
+    def newton(self, sys_: GridSystem) -> np.ndarray:
+        """Newton with a backtracking line search from v^n to |R| <= tol x scale; leaves the
+        converged velocity on the grid and returns it."""
+        st = self.st
+        how = linear_solver(self.case, sys_.n)
+        if self.linear is None or self.linear.how != how:
+            self.linear = LinearSolver(how, LINEAR_RTOL)
+        v = sys_.v0
+        f_int, tangent = self.internal(sys_, v)
+        R, scale = self.residual(sys_, v, f_int)
+        it = 0
+        while not np.linalg.norm(R) <= self.tol * scale:  # NaN too
+            if it == self.max_iterations or not np.isfinite(R).all():
+                raise NewtonError(
+                    f"implicit step {int(st.scalars.step[None])} (t = {st.scalars.t[None]:.4g} s): "
+                    f"Newton did not converge in {it} iterations (residual "
+                    f"{np.linalg.norm(R) / scale:.2e} of the force scale, tolerance {self.tol:g}); "
+                    "try a smaller time.dt_s or a larger time.newton_max_iterations"
+                )
+            dv = self.linear.solve(sys_.matrix(sys_.fixed + tangent), -R)
+            norm0 = np.linalg.norm(R)
+            alpha = 1.0
+            for _ in range(LINE_SEARCH_HALVINGS):
+                v_try = v + alpha * dv
+                f_try, tan_try = self.internal(sys_, v_try)
+                R_try, scale_try = self.residual(sys_, v_try, f_try)
+                if np.linalg.norm(R_try) < norm0:
+                    break
+                alpha *= 0.5
+            v, f_int, tangent, R, scale = v_try, f_try, tan_try, R_try, scale_try
+            it += 1
+        self.newton_total += it
+        self.last = StepReport(it, sys_.n, float(np.linalg.norm(R) / scale), how)
+        return v

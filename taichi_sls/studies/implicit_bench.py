@@ -1,0 +1,138 @@
+"""Both integrators side by side: ``taichi-sls bench implicit [--quick] [--out renders]``.
+
+Rows, each run, timed (wall time of the whole run with a warm kernel cache: the first call of a
+configuration compiles it, 10-20 s, later calls load it) and compared with its reference:
+
+- verification cases against their exact solutions (Hopper's coalescence from his outline at
+  R0/h = 20, the viscous decay of a disc mode and the Laplace pressure at R/h = 10), explicit and
+  implicit at steps 10x and 100x the explicit capillary limit;
+- a second of viscous sintering of a PA12 pair (cases/verification/hopper_pa12.toml, out of the
+  explicit integrator's reach: 3e8 steps) at R0/h = 10 and 20;
+- the paper's 25 W case (coarse grid, h = 4 um) to 1 ms: neck and peak temperature of both.
+
+Writes ``implicit.csv`` and ``implicit.json`` and prints the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+from ..config import load_case
+from ..solver.simulation import Simulation
+from ..solver.time_step import time_step_limits
+from . import verification as ver
+
+IMPLICIT = {"integrator": "implicit"}
+COLUMNS = ["row", "integrator", "dt_s", "steps", "wall_s", "measure", "value", "error"]
+
+
+def _capillary_multiple(name: str, res: float, k: float) -> dict:
+    """The implicit time table at k times the explicit capillary limit of case ``name``."""
+    limit = time_step_limits(ver.load(name, res).case)["surface_tension"]
+    return {**IMPLICIT, "dt_s": k * limit}
+
+
+def verification_rows(quick: bool) -> list[dict]:
+    """(row, resolution, time table or None for the case's own) of the verification rows."""
+    rows = [
+        ("hopper_shape", 20, None),
+        ("hopper_shape", 20, 10.0),
+        ("hopper_shape", 20, 100.0),
+        ("viscous_decay", 10, None),
+        ("viscous_decay", 10, 100.0),
+        ("laplace", 10, None),
+        ("laplace", 10, 10.0),
+        ("hopper_pa12", 10, "case"),
+        ("hopper_pa12", 20, "case"),
+    ]
+    if quick:
+        rows = [r for r in rows if r[0] != "hopper_shape" or r[2] == 100.0]
+    out = []
+    for name, res, k in rows:
+        sets = None
+        if isinstance(k, float):
+            sets = {"time": _capillary_multiple(name, res, k)}
+        t0 = time.perf_counter()
+        r = ver.run(ver.load(name, res, sets))
+        wall = time.perf_counter() - t0
+        integrator = "explicit" if k is None else "implicit"
+        label = f"{name} R/h = {res:g}" + (
+            f", {k:g}x capillary limit" if isinstance(k, float) else ""
+        )
+        for measure, err in r.errors.items():
+            out.append(
+                {
+                    "row": label,
+                    "integrator": integrator,
+                    "dt_s": r.dt_s,
+                    "steps": r.steps,
+                    "wall_s": round(wall, 2),
+                    "measure": measure,
+                    "value": r.info.get(measure.replace("neck_", "neck_sim_"), math.nan),
+                    "error": err,
+                }
+            )
+        print(out[-1], file=sys.stderr, flush=True)
+    return out
+
+
+def paper_rows(end_s: float = 1e-3) -> list[dict]:
+    """The 25 W pair on the coarse grid to end_s: neck and peak temperature, both integrators."""
+    out = []
+    for integrator in ("explicit", "implicit"):
+        case = load_case("power25W_coarse", [f"time.integrator={integrator}", "time.dt_s=auto"])
+        t0 = time.perf_counter()
+        sim = Simulation(case)
+        n = int(round(end_s / sim.dt))
+        sim.advance(n)
+        wall = time.perf_counter() - t0
+        mon = sim.monitors()
+        for measure in ("contact_line_um", "T_peak_C"):
+            out.append(
+                {
+                    "row": f"power25W_coarse to {end_s:g} s",
+                    "integrator": integrator,
+                    "dt_s": sim.dt,
+                    "steps": n,
+                    "wall_s": round(wall, 2),
+                    "measure": measure,
+                    "value": mon[measure],
+                    "error": math.nan,
+                }
+            )
+        print(out[-2:], file=sys.stderr, flush=True)
+    explicit = {r["measure"]: r["value"] for r in out if r["integrator"] == "explicit"}
+    for r in out:
+        r["error"] = r["value"] / explicit[r["measure"]] - 1.0  # against the explicit run
+    return out
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    ap = sub.add_parser("implicit", help="explicit and implicit integrators side by side")
+    ap.add_argument("--out", default="renders", help="folder for implicit.csv and .json")
+    ap.add_argument("--quick", action="store_true", help="fewer Hopper rows")
+    ap.set_defaults(func=main)
+
+
+def main(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = verification_rows(args.quick) + paper_rows()
+    with (out / "implicit.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    (out / "implicit.json").write_text(json.dumps(rows, indent=1))
+    for r in rows:
+        print(
+            f"{r['row'][:44]:44s} {r['integrator']:9s} dt {r['dt_s']:9.3g} s {r['steps']:8d} "
+            f"steps {r['wall_s']:7.1f} s  {r['measure']:16s} {r['value']:10.4g} "
+            f"error {r['error']:+.4f}"
+        )
+    return 0

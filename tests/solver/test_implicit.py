@@ -1,0 +1,174 @@
+"""The implicit integrator (solver/implicit.py): its tangent, its capillary stiffness, its linear
+solves, its verification rows at steps far beyond the explicit limits, and its input checks."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from helpers import deep_update
+
+from taichi_sls.config import CaseError, load_case
+from taichi_sls.solver.linear_solve import LinearSolver
+from taichi_sls.solver.simulation import Simulation
+from taichi_sls.solver.time_step import resolve_dt, resolve_heat_substeps, time_step_limits
+from taichi_sls.studies import verification as ver
+
+IMPLICIT = {"time": {"integrator": "implicit"}}
+
+
+# one configuration for the tangent checks, so that their kernels compile once: the zero-yield
+# Maxwell disc with a solvent viscosity, one step taken (stressed, moving, gamma ramping in)
+DISC = {
+    "time": {"integrator": "implicit", "dt_s": 2e-6},
+    "materials": {"fluid": {"solvent_viscosity_Pa_s": 0.05}},
+}
+
+
+def _stepped_disc() -> Simulation:
+    """The Laplace disc of Maxwell fluid at R/h = 10 (cases/verification/laplace.toml)."""
+    sim = Simulation(ver.load("laplace", 10, DISC).case)
+    sim.advance(1)
+    return sim
+
+
+def test_tangent_is_the_derivative_of_the_internal_force():
+    """Small-strain incremental update, prestressed by a first step: the internal force is
+    affine in the grid velocity (the zero-yield return's secant ratio tau / (tau + dt) does not
+    depend on the strain increment; the solvent stress is linear), so the assembled tangent
+    times a velocity change is the internal force's change to round-off. Tolerance 1e-9
+    relative: a wrong index, sign or factor shows at order one."""
+    sim = _stepped_disc()
+    stepper = sim.implicit
+    system = stepper.prepare()
+    rng = np.random.default_rng(1)
+    v0 = system.v0
+    dv = rng.normal(size=system.n) * np.abs(v0).max()
+    f0, tangent = stepper.internal(system, v0)
+    f1, _ = stepper.internal(system, v0 + dv)
+    K = system.matrix(tangent)
+    assert abs(K - K.T).max() <= 1e-12 * abs(K).max()
+    change = -(f1 - f0)
+    assert np.linalg.norm(K @ dv - change) <= 1e-9 * np.linalg.norm(change)
+
+
+def test_capillary_stiffness_is_symmetric_semidefinite_and_blind_to_translation():
+    """The surface Laplacian gamma dt sum_q w_q L_q (t . grad N_i)(t . grad N_j): symmetric,
+    v^T K v >= 0, and zero on a uniform velocity (grad of a constant along t), so the implicit
+    capillary term holds back no rigid motion. The fixed matrix less its inertia m_i / dt."""
+    sim = _stepped_disc()
+    system = sim.implicit.prepare()
+    A = system.matrix(system.fixed)
+    mass = sim.state.nodes.mass.to_numpy()
+    i, j, c = system.dof_node.T
+    K = A - sp.diags(mass[i, j] / sim.dt)
+    assert abs(K).max() > 0
+    assert abs(K - K.T).max() <= 1e-12 * abs(K).max()
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        v = rng.normal(size=system.n)
+        assert v @ (K @ v) >= -1e-12 * abs(K).max() * (v @ v)
+    # rows whose every neighbour is an unknown: the row sum per component vanishes
+    uniform = (c == 0).astype(float)
+    full = np.diff(system.indptr) == system.slots.shape[1]
+    assert full.sum() > 0.5 * system.n
+    row = K @ uniform
+    assert np.abs(row[full]).max() <= 1e-10 * abs(K).max()
+
+
+@pytest.mark.parametrize("how", ["direct", "amg"])
+def test_linear_solver_reuses_its_preconditioner(how):
+    """A 2D grid operator (mass plus Laplacian, SPD) solved to the relative residual asked; a
+    drifted matrix of the same pattern is solved with the kept factorization or hierarchy as
+    CG's preconditioner (direct: no new factorization while CG converges within its limit)."""
+    n = 60
+    lap = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    A = (sp.kronsum(lap, lap) + 0.01 * sp.eye(n * n)).tocsr()
+    b = np.random.default_rng(3).normal(size=n * n)
+    solver = LinearSolver(how, rtol=1e-8)
+    x = solver.solve(A, b)
+    assert np.linalg.norm(A @ x - b) <= 1e-7 * np.linalg.norm(b)
+    A2 = A.copy()
+    A2.data *= 1.0 + 0.02 * np.cos(np.arange(A2.nnz))  # same pattern, drifted values
+    A2 = ((A2 + A2.T) * 0.5).tocsr()
+    x2 = solver.solve(A2, b)
+    assert np.linalg.norm(A2 @ x2 - b) <= 1e-7 * np.linalg.norm(b)
+    assert solver.stats.factorizations == 1
+    assert solver.stats.cg_iterations > 0
+
+
+@pytest.mark.slow
+def test_implicit_viscous_decay_beside_the_explicit():
+    """The n = 2 mode of a Maxwell-fluid disc at R/h = 10 (cases/verification/viscous_decay.toml)
+    at dt = 1 us, 151x the explicit step and 2x its capillary limit, against the explicit run of
+    the same case side by side: the fitted rate within 2 % of the explicit one (backward Euler's
+    first-order lag, dt times the rate 0.6 %, plus the fit) and within the explicit test's 20 % of
+    Stokes' n gamma / (2 eta_N R) (the coarse grid's bias)."""
+    explicit = ver.run(ver.load("viscous_decay", 10))
+    implicit = ver.run(
+        ver.load("viscous_decay", 10, deep_update(IMPLICIT, {"time": {"dt_s": 1e-6}}))
+    )
+    print("viscous decay explicit / implicit:", explicit.info, implicit.info)
+    assert implicit.steps * 100 < explicit.steps
+    ratio = implicit.info["rate_1_s"] / explicit.info["rate_1_s"]
+    assert abs(ratio - 1.0) < 0.02
+    assert abs(implicit.errors["decay_rate"]) < 0.2
+
+
+@pytest.mark.slow
+def test_implicit_laplace_pressure_at_a_large_step():
+    """A disc of Maxwell fluid at rest carries gamma / R (cases/verification/laplace.toml, R/h =
+    10) at dt = 5 us, 10x the capillary limit: the explicit test's 2 % on the pressure and its
+    capillary-number bound 0.02 on the spurious currents."""
+    vc = ver.load("laplace", 10, deep_update(IMPLICIT, {"time": {"dt_s": 5e-6}}))
+    assert 5e-6 > 10 * time_step_limits(vc.case)["surface_tension"]
+    r = ver.run(vc)
+    print("implicit Laplace, R/h = 10:", r.errors, r.info)
+    assert abs(r.errors["pressure"]) < 0.02
+    assert r.errors["capillary_number"] < 0.02
+
+
+@pytest.mark.parametrize(
+    "sets, key",
+    [
+        (["solver.update=musl"], "solver.update"),
+        (["surface_tension.method=csf"], "surface_tension.method"),
+        (["time.linear_solver=lu"], "linear_solver"),
+        (["time.newton_tolerance=0"], "newton_tolerance"),
+    ],
+)
+def test_implicit_input_errors_name_the_key(sets, key):
+    with pytest.raises(CaseError, match=key):
+        load_case("power25W_coarse", ["time.integrator=implicit", *sets])
+
+
+def test_implicit_step_takes_heat_substeps():
+    """A step beyond the heat's limit takes the fewest substeps of at most heat_step_fraction of
+    the thermal limit; "auto" is implicit_step_factor times the explicit "auto" step."""
+    case = load_case("power25W_coarse", ["time.integrator=implicit", "time.dt_s=1e-4"])
+    dt, limits = resolve_dt(case)
+    assert dt == 1e-4 and limits == {}
+    heat_step = case.time.heat_step_fraction * time_step_limits(case)["thermal"]
+    n = resolve_heat_substeps(case, dt)
+    assert dt / n <= heat_step < dt / (n - 1)
+    auto = load_case("power25W_coarse", ["time.integrator=implicit"])
+    explicit, _ = resolve_dt(load_case("power25W_coarse"))
+    assert resolve_dt(auto)[0] == pytest.approx(auto.time.implicit_step_factor * explicit)
+
+
+def test_implicit_heat_keeps_the_energy_balance():
+    """The 25 W pair (coarse grid) over the laser pulse and after, implicit steps of 5 us (95x
+    the explicit step; 10 us moves the collapsing point contact over half a cell in the first
+    step, which the guard refuses) with their heat substeps: the enthalpy rise equals the laser
+    energy to round-off (the guard's bound, 1e-6 in f64, checked at every monitor; measured
+    ~1e-15) and the peak temperature follows the explicit run's within 1 % (the same heat
+    update, on points that moved differently)."""
+    sets = ["time.integrator=implicit", "time.dt_s=5e-6", "time.end_s=1e-4"]
+    sim = Simulation(load_case("power25W_coarse", sets))
+    assert sim.heat_substeps > 1
+    for _ in range(20):
+        sim.advance(1)
+        mon = sim.monitors()
+        assert abs(sim.energy_error(mon)) < 1e-12
+    assert mon["laser_energy_J_per_m"] > 0
+    ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
+    ref.advance(int(round(1e-4 / ref.dt)))
+    assert mon["T_peak_C"] == pytest.approx(ref.monitors()["T_peak_C"], rel=0.01)
