@@ -172,3 +172,31 @@ def test_implicit_heat_keeps_the_energy_balance():
     ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
     ref.advance(int(round(1e-4 / ref.dt)))
     assert mon["T_peak_C"] == pytest.approx(ref.monitors()["T_peak_C"], rel=0.01)
+
+
+@pytest.mark.slow
+def test_implicit_hopper_from_his_outline_at_ten_times_the_capillary_limit():
+    """Hopper's coalescence from his outline at tau0 = 0.3 (cases/verification/hopper_shape.toml,
+    R0/h = 20) at 10x the explicit capillary limit (510x the explicit step): r_n / R0 within the
+    3 % of the issue at tau = 0.5, 1, 2, 3 (measured +2.7 / +0.2 / +0.0 / -0.2 %, the explicit run
+    +3.15 / +0.26 / +0.08 / -0.14 %), area within 0.5 %."""
+    limit = time_step_limits(ver.load("hopper_shape", 20).case)["surface_tension"]
+    r = ver.run(ver.load("hopper_shape", 20, deep_update(IMPLICIT, {"time": {"dt_s": 10 * limit}})))
+    print("implicit Hopper, 10x:", r.errors)
+    for tau in (0.5, 1, 2, 3):
+        assert abs(r.errors[f"neck_tau{tau:g}"]) < 0.03
+    assert abs(r.errors["area"]) < 0.005
+
+
+@pytest.mark.slow
+def test_a_second_of_sintering_against_hopper():
+    """cases/verification/hopper_pa12.toml at R0/h = 10: the paper's pair as a zero-yield melt of
+    Table 3's viscosity at 180 C coalesces for a second (tau = 1) in 10 ms steps; r_n / R0
+    within the issue's 3 % of Hopper at tau = 0.5 and 1 (measured -2.25 / -2.14 %), area within
+    0.5 %."""
+    r = ver.run(ver.load("hopper_pa12", 10))
+    print("a second of sintering:", r.errors, r.info)
+    assert r.steps <= 120
+    for tau in (0.5, 1):
+        assert abs(r.errors[f"neck_tau{tau:g}"]) < 0.03
+    assert abs(r.errors["area"]) < 0.005
