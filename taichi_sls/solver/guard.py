@@ -62,6 +62,8 @@ class Guard:
         hint = f"time step {self.dt:.3g} s against the limits " + ", ".join(
             f"{k} {v:.3g} s" for k, v in self.limits.items()
         )
+        if st.cfg.implicit:  # no stability limit: the step is too long for the flow it resolves
+            hint = f"implicit time step {self.dt:.3g} s: try a smaller time.dt_s"
         problem = None
         kind = ""  # which of WATCHED the detected problem is, if any
         finite = all(math.isfinite(v) for k, v in mon.items() if not k.endswith("_um"))

@@ -309,6 +309,19 @@ class ImplicitStepper:
         for _ in range(n):
             self.step()
 
+    def compile(self) -> None:
+        """Compile the step's kernels that touch only the grid, by running them once on the
+        points as they are (the grid is scratch, rebuilt by every step); the heat substep and
+        the G2P compile on the first step."""
+        st = self.st
+        begin(st)
+        none = np.empty((0, 3), dtype=np.int32)
+        internal_force(st, np.empty(0), none)
+        rows = np.empty((0, self._slots))
+        gather(
+            st, st.implicit.fixed, none, rows.astype(np.int32), rows, np.empty(0), np.empty(0), True
+        )
+
     def step(self) -> None:
         sys_ = self.prepare()
         if sys_.n:

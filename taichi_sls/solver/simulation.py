@@ -113,6 +113,8 @@ class Simulation:
         t0 = time.perf_counter()
         if self.implicit is None:
             advance(self.state, 0)  # compiles the step kernel
+        else:
+            self.implicit.compile()
         self.compile_s = time.perf_counter() - t0
         self._mass = self.state.points.mass.to_numpy()
         # each point's index in the order the run started with: the blocks layout sorts the
