@@ -232,19 +232,25 @@ def solvent_stress(mp: ti.template(), L, xi):
 
 
 @ti.func
-def _finite_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, f, J, dt):
-    """:func:`hencky_update` of point p with its stored state: f = I + dt L (3x3), J = det F
-    after the step."""
+def _iso_step(cfg: ti.template(), pt: ti.template(), p):
+    """Point p's isotropic thermal and solidification strain of this step (0 without them)."""
     d_iso = 0.0
     if ti.static(cfg.th_strain):
         d_iso = pt.iso_strain_step[p]
+    return d_iso
+
+
+@ti.func
+def _finite_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, f, J, dt):
+    """:func:`hencky_update` of point p with its stored state: f = I + dt L (3x3), J = det F
+    after the step."""
     return hencky_update(
         mat[pt.material[p]],
         pt.elastic_stretch[p],
         pt.stress_phase[p],
         pt.equivalent_plastic_strain[p],
         f,
-        d_iso,
+        _iso_step(cfg, pt, p),
         pt.solid_fraction[p],
         pt.T[p],
         J,
@@ -257,14 +263,11 @@ def _finite_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, f
 @ti.func
 def _incremental_step(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, deps, dt):
     """:func:`perzyna_increment` of point p with its stored state, strain increment deps."""
-    d_iso = 0.0
-    if ti.static(cfg.th_strain):
-        d_iso = pt.iso_strain_step[p]
     return perzyna_increment(
         mat[pt.material[p]],
         pt.stress[p],
         embed3(deps),
-        d_iso,
+        _iso_step(cfg, pt, p),
         pt.equivalent_plastic_strain[p],
         pt.solid_fraction[p],
         pt.T[p],

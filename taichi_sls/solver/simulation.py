@@ -16,12 +16,13 @@ from . import checkpoint
 from .blocks import BlockPlan
 from .contacts import neck_width, point_colour, touching
 from .fields import State
+from .grid_views import colour_only, level_set_only
 from .guard import Guard
 from .implicit import ImplicitStepper
 from .monitor import neck_measures, point_monitors
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
-from .step import advance, colour_only, init_box, level_set_only
+from .step import advance, init_box
 from .step_config import Layout, choose_layout, step_config
 from .time_step import (
     resolve_curvature_every,

@@ -10,7 +10,8 @@
                    strain split and Perzyna return map (eqs. 34-45); the active region grows
     advance_clock  t += dt
 
-``STAGES`` writes this order once; every layout and the diagnostic kernels run it (or a prefix
+``STAGES`` writes this order once; every layout, the implicit step (solver/implicit.py) and the
+grid views (solver/grid_views.py) run it (or a prefix
 of it). Two clocks skip what a step does not need. * Heat runs every ``heat_every`` steps with a
 heat step of heat_every * dt: conduction's stability limit is ~100x the elastic one, and its
 thermal strain increment is spread over the mechanical steps that follow. ** The level set and
@@ -31,7 +32,7 @@ from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
-from ..physics.level_set import level_set, scatter_level_set
+from ..physics.level_set import scatter_level_set
 from ..physics.mechanics import (
     g2p_kinematics,
     g2p_velocity,
@@ -41,7 +42,7 @@ from ..physics.mechanics import (
     p2g_momentum,
 )
 from ..physics.shape import stencil
-from ..physics.surface_energy import colour_field, scatter_volume, surface_energy_force
+from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
     g2p_heat,
     grid_heat,
@@ -407,37 +408,3 @@ def advance_staged(st: State, n: int) -> None:
     for i in range(k, k + n):
         for stage in STAGES:
             run_stage(st, stage, *_clocks(st, i))
-
-
-@ti.kernel
-def level_set_only(st: ti.template()):
-    """The level set of eq. 21 of the current points, for monitors (also with surface tension
-    off). Leaves the curvature the step keeps between rebuilds untouched."""
-    grow_box_all(st)
-    for I in ti.grouped(ti.ndrange(*active(st.box))):
-        st.nodes.phi_raw[I] = st.cfg.phi_cap
-    point_loop(st, _level_set_body, False, True, True)
-    level_set(st.cfg, st.box, st.nodes, st.surf)
-
-
-@ti.func
-def _level_set_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    base, w, dw = point_stencil(st.cfg, st.points, p)
-    scatter_level_set(st.cfg, st.points, st.nodes, p, base)
-
-
-@ti.kernel
-def colour_only(st: ti.template()):
-    """The surface-energy colour of the current points (nodes.colour), for monitors: the step's
-    stages up to P2G without heat or geometry, then the colour (filtered as the case says)."""
-    for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
-        stage(st, False, False)
-    colour_field(st.cfg, st.box, st.nodes)
-
-
-@ti.kernel
-def surface_only(st: ti.template()):
-    """Grid mass, level set, curvature and capillary force of the current points, without a
-    step (diagnostics and verification): the step's stages through the surface force."""
-    for stage in ti.static(STAGES[: SURFACE + 1]):
-        stage(st, True, True)

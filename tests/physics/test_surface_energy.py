@@ -8,9 +8,9 @@ import pytest
 from helpers import deep_update, neck_and_kinetic_energy
 
 from taichi_sls.config import CaseError, case_from_dict, load_case
+from taichi_sls.solver.grid_views import surface_only
 from taichi_sls.solver.scene import build_scene, inside_polygon
 from taichi_sls.solver.simulation import Simulation
-from taichi_sls.solver.step import surface_only
 from taichi_sls.studies import verification as ver
 from taichi_sls.studies.verification.hopper import colour_section, hopper_layout
 

@@ -19,7 +19,7 @@ def run_curvature(vc: VerificationCase) -> Result:
     """Curvature of a disc of points as the level set reconstructs it (eqs. 21-23): mean and RMS
     of kappa R - 1 over the interface nodes."""
     case = vc.case
-    from ...solver.step import surface_only
+    from ...solver.grid_views import surface_only
 
     t0 = time.perf_counter()
     sim = simulation(vc)
@@ -79,7 +79,7 @@ def run_laplace(vc: VerificationCase) -> Result:
     gamma = m.surface_tension_N_m
     curvature = math.nan  # the CSF's curvature at the end (the surface-energy force has none)
     if case.surface_tension.method == "csf":
-        from ...solver.step import surface_only
+        from ...solver.grid_views import surface_only
 
         surface_only(st)  # the curvature the settled points give, where the CSF force acts
         k = st.nodes.kappa.to_numpy()

@@ -1,0 +1,45 @@
+"""The grid fields of the current points without a step, for monitors, diagnostics and
+verification: the level set of eq. 21, the surface-energy colour, and the step's stages through
+the surface force (solver/step.py)."""
+
+import taichi as ti
+
+from ..physics.grid import active
+from ..physics.level_set import level_set, scatter_level_set
+from ..physics.surface_energy import colour_field
+from .loops import point_loop
+from .step import STAGES, SURFACE, grow_box_all, p2g, point_stencil
+
+
+@ti.kernel
+def level_set_only(st: ti.template()):
+    """The level set of eq. 21 of the current points, for monitors (also with surface tension
+    off). Leaves the curvature the step keeps between rebuilds untouched."""
+    grow_box_all(st)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        st.nodes.phi_raw[I] = st.cfg.phi_cap
+    point_loop(st, _level_set_body, False, True, True)
+    level_set(st.cfg, st.box, st.nodes, st.surf)
+
+
+@ti.func
+def _level_set_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    scatter_level_set(st.cfg, st.points, st.nodes, p, base)
+
+
+@ti.kernel
+def colour_only(st: ti.template()):
+    """The surface-energy colour of the current points (nodes.colour), for monitors: the step's
+    stages up to P2G without heat or geometry, then the colour (filtered as the case says)."""
+    for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
+        stage(st, False, False)
+    colour_field(st.cfg, st.box, st.nodes)
+
+
+@ti.kernel
+def surface_only(st: ti.template()):
+    """Grid mass, level set, curvature and capillary force of the current points, without a
+    step (diagnostics and verification): the step's stages through the surface force."""
+    for stage in ti.static(STAGES[: SURFACE + 1]):
+        stage(st, True, True)
