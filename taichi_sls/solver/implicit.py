@@ -17,8 +17,10 @@ One step, over the explicit step's stages (solver/step.py) where they are the sa
                the active region, the clock
 
 The internal force of the new stress is taken on the configuration at t^n, where the shape
-functions are evaluated: f_i = -V_p^n P grad N_i(x_p^n) with the first Piola stress of the step
-P = det(f) sigma f^-T, f = I + dt L (exact for the shape functions' own deformation).
+functions are evaluated: f_i = -V_p^n sigma^{n+1} grad N_i(x_p^n), linear in the stress, so that
+the material tangent is the whole tangent (the first Piola form det(f) sigma f^-T of the step,
+f = I + dt L, added a geometric nonlinearity that the material tangent missed: Newton stalled
+and Hopper's pair blew up at 20x the capillary limit).
 
 Linear solver (``time.linear_solver``, solver/linear_solve.py): an LDL^T factorization up to
 ``direct_max_unknowns``, else pyamg's smoothed aggregation, either kept as the preconditioner of

@@ -112,6 +112,7 @@ STUDIES = (
         case="hopper",
     ),
     Study("hopper_shape", (10, 20), (), "neck_tau1"),
+    Study("hopper_pa12", (10, 20), (10,), "neck_tau1"),  # the implicit integrator's
 )
 
 
