@@ -5,6 +5,7 @@ randomized run found the guard's NaN-location bug (fixed, tests/test_run.py)."""
 
 import math
 
+import pytest
 from helpers import PAPER_SCENE, deep_update
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -98,6 +99,7 @@ def test_any_disc_is_inside_or_refused(cx, cy, r):
     assert n > 0
 
 
+@pytest.mark.slow  # six full runs, ~115 s; the bad-input fuzz above stays in the default suite
 @settings(
     max_examples=6, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
 )

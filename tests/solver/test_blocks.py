@@ -50,6 +50,7 @@ def test_blocks_layout_does_not_depend_on_the_thread_count():
         assert np.array_equal(one[k], two[k]), k
 
 
+@pytest.mark.slow  # ~90 s; the resumed-after-a-sort test below sorts the drifted points too
 def test_points_are_sorted_again_when_they_drift():
     """Every point carried 5 cells along x half way through the run (further than a block's
     margin): the points are sorted again and the result still matches the serial layout."""

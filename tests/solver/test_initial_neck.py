@@ -25,6 +25,7 @@ def test_a_prescribed_8um_neck_reads_8um(h):
     assert _neck_um("contact_neck", h) == pytest.approx(8.0, rel=0.05)
 
 
+@pytest.mark.slow  # ~55 s at h = 1 um; the prescribed 8 um neck at h = 2 um stays in default
 def test_the_paper_pair_with_a_fillet_reads_its_neck_at_h_2_and_1():
     """The paper's touching discs joined by 2 um fillets: neck 2 (sqrt(rho^2 + 2 R rho) - rho)
     = 14.33 um; read within 2 % at h = 2 and 1 um (measured +0.5 % and +0.3 %)."""
