@@ -207,6 +207,11 @@ class Case(Model):
             )
         return self
 
+    def implicit_mechanics(self) -> bool:
+        """Whether the mechanics steps implicitly (``time.integrator``; without mechanics there
+        is nothing to step)."""
+        return self.time.integrator == "implicit" and self.physics.mechanics
+
     def lasers_off_s(self) -> float:
         """The time after which no laser heats (s): switched off, or scanned past x_end_um."""
         ends = [0.0]

@@ -299,7 +299,7 @@ class ImplicitStepper:
     def __init__(self, case: Case, st: State, heat_substeps: int) -> None:
         self.case = case
         self.st = st
-        self.heat_substeps = heat_substeps if st.cfg.thermal else 0
+        self.heat_substeps = heat_substeps  # 0 without heat (time_step.resolve_heat_substeps)
         self.tol = case.time.newton_tolerance
         self.max_iterations = case.time.newton_max_iterations
         self.last = StepReport()

@@ -89,8 +89,9 @@ class Simulation:
             self.scene = self.scene.reordered(self.blocks.order(self.scene.x))
             self.blocks.set_ranges(self.scene.x)
         # the implicit step's heat substeps (0: no heat, or the explicit step)
-        implicit = case.time.integrator == "implicit" and case.physics.mechanics
+        implicit = case.implicit_mechanics()
         self.heat_substeps = resolve_heat_substeps(case, self.dt) if implicit else 0
+        dt_heat = self.dt / max(self.heat_substeps, 1)
         cfg = step_config(
             case,
             self.scene,
@@ -100,7 +101,7 @@ class Simulation:
             time_step_limits(case).get("thermal", math.inf)
             if implicit
             else self.dt_limits.get("thermal", math.inf),
-            self.dt / max(self.heat_substeps, 1),
+            dt_heat,
         )
         mats = material_arrays(case, self.scene.material_names)
         self.state = State(cfg, self.scene, mats, laser_arrays(case), self.blocks)
@@ -109,7 +110,7 @@ class Simulation:
         self.steps = 0
         self.implicit = None
         if cfg.implicit:
-            self.state.scalars.dt_heat[None] = self.dt / max(self.heat_substeps, 1)
+            self.state.scalars.dt_heat[None] = dt_heat
             self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
         t0 = time.perf_counter()
         if self.implicit is None:

@@ -167,7 +167,7 @@ def step_config(
     rho_ref = first.density_kg_m3 * sv.mass_scale
     layout = choose_layout(case, scene.n_points)
     floor = st.surface_energy_mass_floor * rho_ref * h**2
-    implicit = case.time.integrator == "implicit" and ph.mechanics
+    implicit = case.implicit_mechanics()
     return StepConfig(
         dim=2,
         n_points=scene.n_points,

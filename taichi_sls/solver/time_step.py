@@ -37,7 +37,7 @@ def resolve_dt(case: Case) -> tuple[float, dict[str, float]]:
     thermal limit can be the smallest, and a heat step near it overshoots); a fixed dt above the
     smallest limit is refused unless ``time.allow_unstable_dt``."""
     limits = time_step_limits(case)
-    if case.time.integrator == "implicit" and case.physics.mechanics:
+    if case.implicit_mechanics():
         return _implicit_dt(case, limits)
     bound = min(limits.values()) if limits else case.time.end_s
     if case.time.dt_s == "auto":
@@ -93,7 +93,7 @@ def resolve_heat_every(case: Case, dt: float, limits: dict[str, float]) -> int:
     """Mechanical steps per heat step. Conduction is explicit with a limit ~100x the elastic
     one (paper's fine grid: 9.8e-6 s against 1.3e-7 s), so the heat update runs on its own,
     slower clock; "auto" keeps its step at ``heat_step_fraction`` of the thermal limit."""
-    if not case.physics.thermal or (case.time.integrator == "implicit" and case.physics.mechanics):
+    if not case.physics.thermal or case.implicit_mechanics():
         return 1
     t = case.time
     lim = limits.get("thermal", math.inf)
