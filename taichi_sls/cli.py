@@ -2,9 +2,10 @@
 
     run CASE         run a case file (or a bundled case by name) with every output
     sweep SWEEP      a parameter sweep on Dask
-    bench STUDY      speed, cost, implicit (both integrators side by side), accuracy, paper (the
-                     Table 2 cases), neck (the melted-pair study), refinement (the paper's cases
-                     under grid and dt refinement)
+    bench STUDY      speed, cost, implicit (both integrators side by side), hold (a melt that
+                     sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
+                     neck (the melted-pair study), refinement (the paper's cases under grid and
+                     dt refinement)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -137,6 +138,7 @@ def parser() -> argparse.ArgumentParser:
         paper,
         refinement,
         robustness,
+        sinter_hold,
         speed,
     )
     from .studies.sweep import runner as sweep
@@ -151,10 +153,20 @@ def parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub)
     bench = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, cost, implicit, accuracy, paper, neck, refinement",
+        help="benchmarks and studies: speed, cost, implicit, hold, accuracy, paper, neck, "
+        "refinement",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
-    for module in (speed, cost_error, implicit_bench, accuracy, paper, neck_study, refinement):
+    for module in (
+        speed,
+        cost_error,
+        implicit_bench,
+        sinter_hold,
+        accuracy,
+        paper,
+        neck_study,
+        refinement,
+    ):
         module.add_parser(studies)
     robustness.add_parser(sub)
     p = sub.add_parser("case", help="print the case-file reference (every key, default, unit)")

@@ -112,6 +112,41 @@ class Time(Model):
     direct_max_unknowns: int = Field(
         200_000, ge=1, description='implicit, linear_solver = "auto": the largest direct solve'
     )
+    heat_integrator: Literal["explicit", "implicit"] = Field(
+        "explicit",
+        description="implicit integrator: the heat in explicit substeps of at most "
+        "heat_step_fraction of its stability limit (explicit), or in one backward-Euler step "
+        "per step (implicit: conduction at the new temperature, the capacity and conductivity "
+        "of the step's start; unconditionally stable, first order; solver/implicit_heat.py)",
+    )
+    adaptive: bool = Field(
+        False,
+        description="implicit: choose each step from the physics (solver/adaptive.py): grow it "
+        "while the temperature and the strain change slowly, shrink it through a laser pulse "
+        "and the melting and freezing fronts, redo a step that overshoots its controls twice "
+        "over or whose Newton fails; dt_s is the first step; the time series logs dt_s",
+    )
+    dt_min_s: AutoPositive = Field(
+        "auto",
+        description='adaptive: the smallest step (s); "auto": the first step / 1000. A step '
+        "that must go below it ends the run with an error",
+    )
+    dt_max_s: AutoPositive = Field(
+        "auto",
+        description='adaptive: the largest step (s); "auto": none (the controls, the frames and the '
+        "laser switch times bound it)",
+    )
+    max_temperature_change_K: float = Field(
+        5.0,
+        gt=0,
+        description="adaptive: the largest temperature change of any point in one step (K)",
+    )
+    max_strain_increment: float = Field(
+        0.02,
+        gt=0,
+        description="adaptive: the largest strain increment of any point in one step: the "
+        "Frobenius norm of f - I, f = F^{n+1} (F^n)^-1 the step's deformation gradient",
+    )
 
 
 class Solver(Model):

@@ -200,6 +200,18 @@ class Case(Model):
                 f"solver.update = {self.solver.update!r}: the implicit integrator moves the "
                 'points with its converged grid velocity (allowed with it: "usl")'
             )
+        if self.time.adaptive and not self.implicit_mechanics():
+            raise CaseError(
+                f"time.adaptive = true with time.integrator = {self.time.integrator!r}"
+                + ("" if self.physics.mechanics else " and physics.mechanics = false")
+                + ": an adaptive step needs the implicit mechanics (the explicit step is "
+                'bounded by its stability limits); allowed: time.integrator = "implicit"'
+            )
+        t = self.time
+        if t.adaptive and "auto" not in (t.dt_min_s, t.dt_max_s) and t.dt_min_s > t.dt_max_s:
+            raise CaseError(
+                f"time.dt_min_s = {t.dt_min_s}: must not exceed time.dt_max_s = {t.dt_max_s}"
+            )
         if self.time.stop == "solidified" and self.time.max_s <= self.lasers_off_s():
             raise CaseError(
                 f"time.max_s = {self.time.max_s}: must exceed the time every laser is off "

@@ -181,13 +181,22 @@ def run_case(
     )
     step_wall = 0.0
     steps0 = sim.steps
+
+    def reached(frame_step: int) -> bool:
+        """Whether the run has reached a frame's step (its time, with the adaptive step)."""
+        if sim.adaptive is None:
+            return sim.steps >= frame_step
+        return sim.t >= frame_step * sim.dt * (1.0 - 1e-12)
+
     solid = False
     try:
         for k in range(k0 + 1, len(schedule) + 1):
-            while sim.steps < schedule[k - 1]:
-                n = min(2000, schedule[k - 1] - sim.steps)
+            while not reached(schedule[k - 1]):
                 t0 = time.perf_counter()
-                sim.advance(n)
+                if sim.adaptive is not None:  # steps of its own size, landing on the frame
+                    sim.advance_to(schedule[k - 1] * sim.dt)
+                else:
+                    sim.advance(min(2000, schedule[k - 1] - sim.steps))
                 step_wall += time.perf_counter() - t0
                 bar.update(sim.t, (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0)
             last = frame(k)
@@ -254,6 +263,7 @@ def run_case(
             step_wall_s=step_wall,
             steps_per_s=(sim.steps - steps0) / step_wall if step_wall > 0 else math.nan,
             final=last,
+            refused_steps=sim.adaptive.refused if sim.adaptive is not None else 0,
             T_peak_C=last.get("T_peak_C"),
             warnings=list(dict.fromkeys(warnings)),
         )

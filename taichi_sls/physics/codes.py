@@ -66,3 +66,11 @@ class Strain(IntEnum):
 
     SMALL = 0  # accumulated eps += sym(L) dt (eqs. 16-17), total or incremental stress form
     FINITE = 1  # F = Fe Fp, Hencky elastic strain, the Perzyna map on the Kirchhoff stress
+
+
+class HeatNode(IntEnum):
+    """A node of the backward-Euler heat step (solver/implicit_heat.py)."""
+
+    EMPTY = 0  # no heat capacity: no point reaches it
+    FREE = 1  # an unknown temperature
+    FIXED = 2  # a fixed-temperature wall's node: its temperature is given

@@ -77,6 +77,20 @@ def scatter_point_tangent(cfg: ti.template(), K: ti.template(), base, w, dw, V, 
 
 
 @ti.func
+def scatter_point_conductance(cfg: ti.template(), K: ti.template(), base, w, dw, Vk):
+    """K_ij += V_p k_p grad N_i . grad N_j over the stencil's node pairs: the conduction of
+    eq. 29, linear in the node temperatures, as the backward-Euler heat step's matrix."""
+    G = stencil_gradients(w, dw)
+    for i in range(3**cfg.dim):
+        oi = stencil_offset(i, cfg.dim)
+        for j in range(3**cfg.dim):
+            gg = 0.0
+            for c in ti.static(range(cfg.dim)):
+                gg += G[i, c] * G[j, c]
+            K[base + oi, stencil_offset(j, cfg.dim) - oi + REACH] += Vk * gg
+
+
+@ti.func
 def scatter_mass(cfg: ti.template(), K: ti.template(), I, m_over_dt):
     """The inertia m_i / dt on node i's diagonal."""
     for a in ti.static(range(cfg.dim)):

@@ -70,6 +70,12 @@ def point_heat_capacity(cfg: ti.template(), mp: ti.template(), T, xi):
 
 
 @ti.func
+def point_conductivity(mp: ti.template(), xi):
+    """k of eq. 29 at solid fraction xi."""
+    return lerp_phase(xi, mp.conductivity_solid_W_mK, mp.conductivity_liquid_W_mK)
+
+
+@ti.func
 def p2g_heat_capacity(
     cfg: ti.template(), pt: ti.template(), nd: ti.template(), mat: ti.template(), p, base, w, dw
 ):
@@ -149,7 +155,7 @@ def p2g_heat_flux(
                 N, gN = node_weight(w, dw, o)
                 scatter_add(cfg, nd.deviation, base + o, N * mc * d)
                 scatter_add(cfg, nd.deviation_capacity, base + o, N * mc)
-    k = lerp_phase(pt.solid_fraction[p], mp.conductivity_solid_W_mK, mp.conductivity_liquid_W_mK)
+    k = point_conductivity(mp, pt.solid_fraction[p])
     Vp = pt.volume0[p] * pt.J[p]
     s = 0.0
     energy = 0.0  # the laser energy the point takes this heat step
@@ -184,9 +190,11 @@ def g2p_heat(
     base,
     w,
     dw,
+    chi,
 ):
     """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains and the
-    heat the point exchanged with fixed walls (J/m, counted in heat_out).
+    heat the point exchanged with fixed walls (J/m, counted in heat_out). ``chi``: the sub-grid
+    filter's fraction this heat step.
 
     Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
     transfer). A point within the support of a fixed node takes the interpolated grid temperature
@@ -223,7 +231,7 @@ def g2p_heat(
         if w_fixed == 0.0:
             # the sub-grid part of the deviation relaxes (module docstring): exactly
             # conservative, since sum_p N m c (d_p - d_i) = 0 at every node
-            dH -= cfg.subgrid_filter * c0 * ((T0 - T_grid) - d_smooth)
+            dH -= chi * c0 * ((T0 - T_grid) - d_smooth)
     if ti.static(cfg.any_fixed):
         if w_fixed > 0.0:
             H_pic = 0.0

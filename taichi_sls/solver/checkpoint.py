@@ -4,6 +4,7 @@ that a resumed run continues bitwise as if uninterrupted (CPU)."""
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -50,14 +51,9 @@ def save(
     """The points, scalars and kept node fields, atomically; ``extra`` numbers alongside;
     ``order`` each point's index at the start (the blocks layout sorts them as they flow) and
     the blocks' ranges of the sorted points."""
-    data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in POINT_MEMBERS}
+    data = capture(st)
     if order is not None:
         data["order"] = np.asarray(order, dtype=np.int64)
-    if st.blocks is not None:
-        data["b_start"] = st.blocks.start.to_numpy()
-        data["b_count"] = st.blocks.count.to_numpy()
-    data.update({f"s_{k}": np.array(getattr(st.scalars, k)[None]) for k in SCALARS})
-    data.update({f"g_{k}": getattr(st.nodes, k).to_numpy() for k in NODE_MEMBERS})
     data["steps"] = np.array(steps)
     data["case_name"] = np.array(case_name)
     for k, v in (extra or {}).items():
@@ -80,19 +76,37 @@ def load(st: State, path: Path, case_name: str) -> tuple[int, dict]:
             f"--resume {path}: checkpoint of case {str(z['case_name'])!r} with {n} points "
             f"does not match case {case_name!r} with {st.n_points} points"
         )
+    restore(st, z)
+    return int(z["steps"]), {k[2:]: z[k].item() for k in z.files if k.startswith("x_")}
+
+
+def capture(st: State) -> dict[str, np.ndarray]:
+    """The state a step changes, as host arrays (the points, the scalars, the kept node fields,
+    the blocks' ranges): what a checkpoint holds, and what the adaptive step restores to redo
+    a step it refused."""
+    data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in POINT_MEMBERS}
+    if st.blocks is not None:
+        data["b_start"] = st.blocks.start.to_numpy()
+        data["b_count"] = st.blocks.count.to_numpy()
+    data.update({f"s_{k}": np.array(getattr(st.scalars, k)[None]) for k in SCALARS})
+    data.update({f"g_{k}": getattr(st.nodes, k).to_numpy() for k in NODE_MEMBERS})
+    data["steps"] = np.array(st.scalars.step[None])
+    return data
+
+
+def restore(st: State, data: Mapping[str, np.ndarray]) -> None:
+    """Put back a state from :func:`capture` (or a checkpoint file's arrays)."""
     for k in POINT_MEMBERS:
-        if f"p_{k}" in z.files or k not in LATER_MEMBERS:
-            getattr(st.points, k).from_numpy(z[f"p_{k}"])
+        if f"p_{k}" in data or k not in LATER_MEMBERS:
+            getattr(st.points, k).from_numpy(data[f"p_{k}"])
     for k in SCALARS:
-        getattr(st.scalars, k)[None] = float(z[f"s_{k}"])
+        getattr(st.scalars, k)[None] = float(data[f"s_{k}"])
     for k in NODE_MEMBERS:
-        getattr(st.nodes, k).from_numpy(z[f"g_{k}"])
-    if st.blocks is not None and "b_start" in z.files:
-        st.blocks.start.from_numpy(z["b_start"])
-        st.blocks.count.from_numpy(z["b_count"])
-    steps = int(z["steps"])
-    st.scalars.step[None] = steps
-    return steps, {k[2:]: z[k].item() for k in z.files if k.startswith("x_")}
+        getattr(st.nodes, k).from_numpy(data[f"g_{k}"])
+    if st.blocks is not None and "b_start" in data:
+        st.blocks.start.from_numpy(data["b_start"])
+        st.blocks.count.from_numpy(data["b_count"])
+    st.scalars.step[None] = int(data["steps"])
 
 
 def point_order(path: Path, n_points: int) -> np.ndarray | None:

@@ -149,6 +149,9 @@ class ImplicitFields:
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.free = ti.Vector.field(cfg.dim, ti.i32, grid)
         self.dof = ti.Vector.field(cfg.dim, ti.i32, grid)
+        if cfg.heat_implicit:  # backward-Euler heat (solver/implicit_heat.py)
+            self.conductance = ti.field(float, grid + (WIDTH,) * cfg.dim)
+            self.heat_node = ti.field(ti.i32, grid)  # physics.codes.HeatNode
 
 
 @ti.data_oriented

@@ -2,10 +2,9 @@
 
 One step, over the explicit step's stages (solver/step.py) where they are the same physics:
 
-    heat       heat_substeps explicit heat steps of dt / heat_substeps (clear_grid, p2g, grid
-               temperature, heat flux, grid heat, the points' heat and thermal strain, summed
-               over the substeps), the points where the step starts: the mechanics of the step
-               sees its thermal strain; the heat keeps its own stability limit
+    heat       explicit substeps of the heat stages, or one backward-Euler heat step
+               (solver/implicit_heat.py), on the points where the step starts; the thermal
+               strain summed over the step, so that its mechanics sees it
     begin      clear_grid, p2g (mass, momentum, body force; no stress force), surface force at
                x^n; the inertia m_i / dt and the capillary stiffness (physics/stiffness.py); v^n
     Newton     R(v) = (m / dt + dt K^cap) v - (m v^n / dt + f^ext + f^cap) - f^int(v) = 0 over
@@ -49,25 +48,21 @@ from ..physics.stiffness import (
     stencil_offset,
 )
 from .fields import State
-from .linear_solve import LinearSolver
+from .guard import SimulationError
+from .implicit_heat import StepHeat
+from .linear_solve import LinearSolver, linear_solver
 from .loops import check_block, grow_box, point_loop
 from .step import (
     advance_clock,
     clear_grid,
-    g2p_point_heat,
     g2p_point_mechanics,
-    grid_temperature_stage,
-    grid_update,
-    heat_flux,
     p2g,
     point_stencil,
     surface_force,
     watch,
 )
 
-# the stages of the explicit step that the implicit one runs: for a heat substep, and (without
-# heat) before its Newton loop
-HEAT_STAGES = (clear_grid, p2g, grid_temperature_stage, heat_flux, grid_update)
+# the stages of the explicit step that the implicit one runs before its Newton loop
 BEFORE = (clear_grid, p2g, surface_force)
 LINE_SEARCH_HALVINGS = 8
 # the relative residual of a Newton step's linear solve (an inexact Newton direction: the
@@ -75,7 +70,7 @@ LINE_SEARCH_HALVINGS = 8
 LINEAR_RTOL = 1e-6
 
 
-class NewtonError(RuntimeError):
+class NewtonError(SimulationError):
     """The implicit step did not converge: the message gives the residual and what to try."""
 
 
@@ -91,36 +86,11 @@ class StepReport:
 
 # ----------------------------------------------------------------------------- kernels
 @ti.func
-def _heat_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    base, w, dw = point_stencil(st.cfg, st.points, p)
-    g2p_point_heat(st, p, blk, base, w, dw, st.scalars.dt[None], heat)
-
-
-@ti.func
 def _clear_matrix(K: ti.template(), I, dim: ti.template()):
     for r in range(WIDTH**dim):
         o = stencil_offset(r, dim, WIDTH)
         for a, b in ti.static(ti.ndrange(dim, dim)):
             K[I, o, a, b] = 0.0
-
-
-@ti.kernel
-def heat_substep(st: ti.template()):
-    """One heat substep: the explicit step's heat stages (eqs. 28-33) over dt_heat, with the
-    points where they are at the start of the step."""
-    if ti.static(st.cfg.parallel):
-        _heat_substep(st)
-    else:  # the serial layout: every loop in order, so that a run repeats bit for bit
-        ti.loop_config(serialize=True)
-        for _ in range(1):
-            _heat_substep(st)
-
-
-@ti.func
-def _heat_substep(st: ti.template()):
-    for stage in ti.static(HEAT_STAGES):
-        stage(st, True, False)
-    point_loop(st, _heat_body, True, False, False)
 
 
 @ti.kernel
@@ -258,14 +228,6 @@ def end(st: ti.template()):
 
 
 # ----------------------------------------------------------------------------- linear solve
-def linear_solver(case: Case, n: int) -> str:
-    """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
-    choice = case.time.linear_solver
-    if choice == "auto":
-        choice = "direct" if n <= case.time.direct_max_unknowns else "amg"
-    return choice
-
-
 # ----------------------------------------------------------------------------- the step
 @dataclass
 class GridSystem:
@@ -299,7 +261,7 @@ class ImplicitStepper:
     def __init__(self, case: Case, st: State, heat_substeps: int) -> None:
         self.case = case
         self.st = st
-        self.heat_substeps = heat_substeps  # 0 without heat (time_step.resolve_heat_substeps)
+        self.heat = StepHeat(case, st, heat_substeps)  # 0 substeps: no heat
         self.tol = case.time.newton_tolerance
         self.max_iterations = case.time.newton_max_iterations
         self.last = StepReport()
@@ -335,13 +297,7 @@ class ImplicitStepper:
     def prepare(self) -> GridSystem:
         """The step up to its Newton loop: ``begin``, the unknowns, the fixed matrix."""
         st = self.st
-        if self.heat_substeps:
-            t0 = float(st.scalars.t[None])
-            dt_heat = float(st.scalars.dt_heat[None])
-            for k in range(self.heat_substeps):
-                st.scalars.t[None] = t0 + k * dt_heat
-                heat_substep(st)
-            st.scalars.t[None] = t0
+        self.heat.advance()
         begin(st)
         free = st.implicit.free.to_numpy()
         flat = free.reshape(-1) != 0

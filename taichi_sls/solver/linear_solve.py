@@ -18,7 +18,17 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..config import Case
+
 CG_MAX_ITERATIONS = 500
+
+
+def linear_solver(case: Case, n: int) -> str:
+    """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
+    choice = case.time.linear_solver
+    if choice == "auto":
+        choice = "direct" if n <= case.time.direct_max_unknowns else "amg"
+    return choice
 
 
 @dataclass

@@ -13,6 +13,7 @@ import taichi as ti
 from ..config import Case
 from ..physics.materials import KELVIN
 from . import checkpoint
+from .adaptive import AdaptiveStepper
 from .blocks import BlockPlan
 from .contacts import neck_width, point_colour, touching
 from .fields import State
@@ -25,6 +26,7 @@ from .scene import Scene, build_scene
 from .step import advance, init_box
 from .step_config import Layout, choose_layout, step_config
 from .time_step import (
+    heat_step_max,
     resolve_curvature_every,
     resolve_dt,
     resolve_heat_every,
@@ -108,10 +110,13 @@ class Simulation:
         self.state.scalars.dt[None] = self.dt
         init_box(self.state)
         self.steps = 0
-        self.implicit = None
+        self.implicit = self.adaptive = None
         if cfg.implicit:
             self.state.scalars.dt_heat[None] = dt_heat
             self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
+            if case.time.adaptive:
+                longest = heat_step_max(case)
+                self.adaptive = AdaptiveStepper(case, self.state, self.implicit, self.dt, longest)
         t0 = time.perf_counter()
         if self.implicit is None:
             advance(self.state, 0)  # compiles the step kernel
@@ -146,11 +151,29 @@ class Simulation:
     def t(self) -> float:
         return float(self.state.scalars.t[None])
 
+    @property
+    def step_dt(self) -> float:
+        """The last step taken (s): ``dt`` but with ``time.adaptive``."""
+        return self.dt if self.adaptive is None else self.adaptive.last_dt
+
+    def advance_to(self, t: float) -> None:
+        """Advance until the clock reaches t (s): adaptive steps that land on it, or the whole
+        fixed steps nearest to it."""
+        if self.adaptive is None:
+            self.advance(round((t - self.t) / self.dt))
+            return
+        self.steps += self.adaptive.advance_to(t, self._after_step)
+
+    def _after_step(self) -> None:
+        if self.blocks is not None and self.blocks.needs_sort[None]:
+            self.sort_points()
+
     def advance(self, n: int) -> None:
         """Advance n steps."""
         if n <= 0:
             return
-        step = advance if self.implicit is None else lambda st, k: self.implicit.advance(k)
+        stepper = self.adaptive or self.implicit
+        step = advance if stepper is None else lambda st, k: stepper.advance(k)
         if self.before_step is not None:
             for _ in range(n):
                 self.before_step(self)
@@ -158,8 +181,7 @@ class Simulation:
         elif self.blocks is not None:
             for _ in range(n):  # a point that drifted out of its block: sort them again
                 step(self.state, 1)
-                if self.blocks.needs_sort[None]:
-                    self.sort_points()
+                self._after_step()
         else:
             step(self.state, n)
         self.steps += n
@@ -304,7 +326,7 @@ class Simulation:
         """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard unless
         ``guard`` is false (the last state of a failed run)."""
         st = self.state
-        out = {"t_s": self.t, "step": float(self.steps)}
+        out = {"t_s": self.t, "step": float(self.steps), "dt_s": self.step_dt}
         public, internal = point_monitors(st)
         out.update(public)
         out["T_peak_C"] = float(st.scalars.T_peak[None] - KELVIN)
@@ -323,6 +345,7 @@ class Simulation:
         if self.steps == 0 and self._H0 is None:
             self._H0 = out["enthalpy_J_per_m"]
         if guard:
+            self.guard.dt = self.step_dt
             self.guard.check(
                 out, internal, self.steps, self.t, self.energy_error(out), self.energy_bound()
             )

@@ -248,7 +248,10 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
     pt, nd, mat = ti.static(st.points, st.nodes, st.materials)
     if ti.static(st.cfg.thermal):
         if heat:
-            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw)
+            chi = st.cfg.subgrid_filter
+            if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
+                chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
+            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi)
             if ti.static(st.cfg.any_fixed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])

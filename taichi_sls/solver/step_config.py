@@ -96,6 +96,8 @@ class StepConfig:
     wall_T: tuple[float, ...]  # K
     any_fixed: bool
     subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
+    subgrid_rate: float  # its rate (1/s): chi = 1 - exp(-rate dt_heat) for a varying heat step
+    heat_implicit: bool  # time.heat_integrator = "implicit" (solver/implicit_heat.py)
     hysteresis: bool  # some material crystallises below its melting range (physics/thermal.py)
     # ---- mass and surface tension
     surface_method: SurfaceMethod
@@ -221,6 +223,8 @@ def step_config(
         )
         if thermal
         else 0.0,
+        subgrid_rate=case.thermal.subgrid_filter / thermal_limit if thermal else 0.0,
+        heat_implicit=implicit and thermal and case.time.heat_integrator == "implicit",
         hysteresis=thermal
         and any(m.crystallization_range_C is not None for m in case.materials.values()),
         surface_method=method,

@@ -66,13 +66,21 @@ def _implicit_dt(case: Case, explicit: dict[str, float]) -> tuple[float, dict[st
     return float(t.dt_s), {}
 
 
+def heat_step_max(case: Case) -> float:
+    """The longest heat step (s): ``heat_step_fraction`` of the thermal limit (inf without
+    heat)."""
+    return case.time.heat_step_fraction * time_step_limits(case).get("thermal", math.inf)
+
+
 def resolve_heat_substeps(case: Case, dt: float) -> int:
-    """Heat substeps per implicit step: the fewest whose step is at most ``heat_step_fraction``
-    of the thermal limit (0 without heat)."""
-    limits = time_step_limits(case)
-    if "thermal" not in limits:
+    """Heat substeps per implicit step: the fewest whose step is at most :func:`heat_step_max`
+    (0 without heat)."""
+    longest = heat_step_max(case)
+    if math.isinf(longest):
         return 0
-    return max(1, math.ceil(dt / (case.time.heat_step_fraction * limits["thermal"]) - 1e-9))
+    if case.time.heat_integrator == "implicit":  # one backward-Euler step
+        return 1
+    return max(1, math.ceil(dt / longest - 1e-9))
 
 
 def _every(

@@ -1,0 +1,163 @@
+"""The step chosen by the physics (``time.adaptive``; the implicit integrator only).
+
+Each step is taken with the current dt and then measured: the largest temperature change of any
+point, dT, and the largest strain increment, de = |f - I| (Frobenius; f = F^{n+1} (F^n)^-1, the
+step's deformation gradient). Against the case's controls, r = max(dT / dT_max, de / de_max),
+and the next step follows as for a first-order method, whose error per step grows with dt:
+dt_next = SAFETY dt / r, at most GROWTH and at least SHRINK times the last, within
+[dt_min, dt_max]. So the step grows while nothing changes fast (laser off, the melt settled) and
+shrinks through the pulse and the melting and freezing fronts. A step with r > REDO (twice over
+its controls) or whose Newton failed is redone from the state before it at a smaller step.
+
+A step never crosses a laser's switch-on or switch-off time, so the pulse starts and stops on
+time, nor a time the caller asks to land on (a frame). A step cut short to land there does not
+shrink the next one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import Case
+from . import checkpoint
+from .fields import State
+from .guard import SimulationError
+from .implicit import ImplicitStepper, NewtonError
+from .step import init_box
+
+SAFETY = 0.9  # aim a little below the controls, so that steady growth is rarely refused
+GROWTH = 2.0  # the most a step may grow over the last one
+SHRINK = 0.2  # the most a step may shrink below the last one, measured or redone
+REDO = 2.0  # a step over its controls by more than this factor is redone smaller
+
+
+@dataclass(frozen=True)
+class StepControls:
+    """The adaptive step's bounds (s) and accuracy controls per step (K, strain)."""
+
+    dt_min: float
+    dt_max: float
+    temperature_K: float
+    strain: float
+
+    @classmethod
+    def from_case(cls, case: Case, dt0: float) -> StepControls:
+        t = case.time
+        dt_min = dt0 / 1000.0 if t.dt_min_s == "auto" else float(t.dt_min_s)
+        dt_max = math.inf if t.dt_max_s == "auto" else float(t.dt_max_s)
+        return cls(dt_min, max(dt_max, dt_min), t.max_temperature_change_K, t.max_strain_increment)
+
+
+def step_changes(
+    T0: np.ndarray, T1: np.ndarray, F0: np.ndarray, F1: np.ndarray
+) -> tuple[float, float]:
+    """(dT, de): the largest temperature change (K) and strain increment |F1 F0^-1 - I| (F:
+    (points, dim, dim)) of any point over one step."""
+    dT = float(np.max(np.abs(T1 - T0), initial=0.0))
+    if len(F0) == 0:
+        return dT, 0.0
+    f = np.linalg.solve(np.swapaxes(F0, 1, 2), np.swapaxes(F1, 1, 2))  # (F1 F0^-1)^T
+    f -= np.eye(F0.shape[1])
+    return dT, float(np.sqrt(np.max(np.einsum("pij,pij->p", f, f))))
+
+
+def next_step(dt: float, ratio: float, controls: StepControls) -> float:
+    """The step after one of ``dt`` whose changes were ``ratio`` times the controls."""
+    factor = min(GROWTH, max(SHRINK, SAFETY / max(ratio, 1e-12)))
+    return min(controls.dt_max, max(controls.dt_min, dt * factor))
+
+
+def laser_switch_times(case: Case) -> list[float]:
+    """Every time a laser with power switches on or stops heating (s), sorted."""
+    edges = set()
+    for las in case.lasers:
+        if las.power_W > 0:
+            edges.add(las.on_s)
+    edges.add(case.lasers_off_s())
+    return sorted(e for e in edges if e > 0.0)
+
+
+class AdaptiveStepper:
+    """Implicit steps of a size chosen by :class:`StepControls` (module docstring).
+    ``heat_step_max``: the longest heat substep (s), which sets the substeps of each step."""
+
+    def __init__(
+        self, case: Case, st: State, implicit: ImplicitStepper, dt0: float, heat_step_max: float
+    ) -> None:
+        self.st = st
+        self.implicit = implicit
+        self.controls = StepControls.from_case(case, dt0)
+        self.dt = min(self.controls.dt_max, max(self.controls.dt_min, dt0))  # the next to try
+        self.heat_step_max = heat_step_max
+        self.edges = laser_switch_times(case)
+        self.last_dt = self.dt  # the last step taken
+        self.refused = 0  # steps redone smaller, over the run
+
+    def set_step(self, dt: float) -> None:
+        """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
+        self.st.scalars.dt[None] = dt
+        self.implicit.heat.set_step(dt, self.heat_step_max)
+
+    def _limit(self, t: float, t_end: float) -> float:
+        """The next step from t: the controller's, cut to land on t_end or a laser switch."""
+        stop = min([t_end, *(e for e in self.edges if e > t * (1 + 1e-12))])
+        return min(self.dt, stop - t)
+
+    def step(self, t_end: float = math.inf) -> None:
+        """One accepted step (redoing refused ones), at most up to ``t_end``."""
+        st = self.st
+        while True:
+            t = float(st.scalars.t[None])
+            dt = self._limit(t, t_end)
+            cut = dt < self.dt
+            before = checkpoint.capture(st)
+            self.set_step(dt)
+            try:
+                self.implicit.step()
+            except NewtonError as e:
+                self._redo(before, dt, SHRINK**0.5 * dt, str(e))
+                continue
+            dT, de = step_changes(
+                before["p_T"], st.points.T.to_numpy(), before["p_F"], st.points.F.to_numpy()
+            )
+            ratio = max(dT / self.controls.temperature_K, de / self.controls.strain)
+            if ratio > REDO and dt > self.controls.dt_min:
+                why = f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g})"
+                self._redo(before, dt, next_step(dt, ratio, self.controls), why)
+                continue
+            self.last_dt = dt
+            if not (cut and ratio <= 1.0):
+                self.dt = next_step(dt, ratio, self.controls)
+            return
+
+    def _redo(self, before: dict[str, np.ndarray], dt: float, smaller: float, why: str) -> None:
+        """Put the state back and make the next try ``smaller``; below dt_min, give up."""
+        checkpoint.restore(self.st, before)
+        init_box(self.st)
+        self.refused += 1
+        if dt <= self.controls.dt_min:
+            raise SimulationError(
+                f"adaptive step at t = {self.st.scalars.t[None]:.4g} s: refused at the smallest "
+                f"step time.dt_min_s = {self.controls.dt_min:.3g} s ({why}); try a smaller "
+                "time.dt_min_s or looser time.max_temperature_change_K / max_strain_increment"
+            )
+        self.dt = max(self.controls.dt_min, min(smaller, dt))
+
+    def advance(self, n: int) -> None:
+        """n accepted steps."""
+        for _ in range(n):
+            self.step()
+
+    def advance_to(self, t_end: float, after_step: Callable[[], None] | None = None) -> int:
+        """Steps until the clock reaches ``t_end``; returns how many were taken."""
+        n = 0
+        while float(self.st.scalars.t[None]) < t_end * (1.0 - 1e-12):
+            self.step(t_end)
+            n += 1
+            if after_step is not None:
+                after_step()
+        return n

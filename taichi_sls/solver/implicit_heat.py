@@ -1,0 +1,191 @@
+"""The heat of the implicit step (solver/implicit.py): explicit substeps, or one backward-Euler
+step (``time.heat_integrator``).
+
+Substeps: the explicit step's heat stages (eqs. 28-33) over dt_heat = dt / substeps, each at most
+``heat_step_fraction`` of the heat's stability limit, on the points where the step starts.
+
+Backward Euler: the explicit heat step moves the node temperatures by dT_i = dt Q_i / c_i with
+the heat rate Q_i = S_i - (K T)_i at the step's start (eq. 29: K_ij = sum_p V_p k_p grad N_ip .
+grad N_jp; S_i the laser of eqs. 30-31). This one takes the conduction at the step's end:
+
+    (C / dt + K_ff) dT_f = Q_f^n
+
+over the free nodes (a heat capacity and no fixed temperature; a fixed wall's nodes keep
+theirs), and every node's rate becomes Q_i = Q_i^n - (K dT)_i. From there the explicit stages go
+on unchanged: dT_i = dt Q_i / c_i, the points' enthalpy (eqs. 32-33), the heat into the fixed
+nodes counted as heat out. Since sum_i K_ij = 0, sum_i Q_i = sum_i S_i whatever dT the linear
+solver returned: the energy balance holds to round-off at any solve tolerance. The capacities
+(the apparent dH/dT, so with the latent heat) and the conductivities are those of the step's
+start, so the step is linear, unconditionally stable and first order in time; ``time.adaptive``
+bounds the temperature change per step through the melting and freezing ranges, where the
+capacity varies.
+"""
+
+import itertools
+import math
+
+import numpy as np
+import scipy.sparse as sp
+import taichi as ti
+
+from ..config import Case
+from ..physics.codes import HeatNode
+from ..physics.grid import active
+from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
+from ..physics.thermal import fixed_temperature, point_conductivity
+from .fields import State
+from .linear_solve import LinearSolver, linear_solver
+from .loops import point_loop
+from .step import (
+    clear_grid,
+    g2p_point_heat,
+    grid_temperature_stage,
+    grid_update,
+    heat_flux,
+    p2g,
+    point_stencil,
+)
+
+# the explicit step's heat stages up to the nodes' heat rate
+RATE_STAGES = (clear_grid, p2g, grid_temperature_stage, heat_flux)
+SUBSTEP_STAGES = (*RATE_STAGES, grid_update)
+# the relative residual of the linear solve: its error moves heat between nodes, never creates it
+HEAT_RTOL = 1e-10
+
+
+@ti.kernel
+def in_order(st: ti.template(), body: ti.template()):
+    """``body(st)`` as one kernel: its loops parallel, or in the serial layout serialized, so
+    that a run repeats bit for bit."""
+    if ti.static(st.cfg.parallel):
+        body(st)
+    else:
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            body(st)
+
+
+@ti.func
+def _heat_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw = point_stencil(st.cfg, st.points, p)
+    g2p_point_heat(st, p, blk, base, w, dw, st.scalars.dt[None], heat)
+
+
+@ti.func
+def substep(st: ti.template()):
+    """One explicit heat substep over dt_heat."""
+    for stage in ti.static(SUBSTEP_STAGES):
+        stage(st, True, False)
+    point_loop(st, _heat_body, True, False, False)
+
+
+@ti.func
+def _conductance_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    pt = ti.static(st.points)
+    base, w, dw = point_stencil(st.cfg, pt, p)
+    k = point_conductivity(st.materials[pt.material[p]], pt.solid_fraction[p])
+    Vk = pt.volume0[p] * pt.J[p] * k
+    scatter_point_conductance(st.cfg, st.implicit.conductance, base, w, dw, Vk)
+
+
+@ti.func
+def rates_and_conductance(st: ti.template()):
+    """The heat rate Q^n, each node's kind and the conduction matrix K."""
+    for stage in ti.static(RATE_STAGES):
+        stage(st, True, False)
+    nd = ti.static(st.nodes)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        for o in ti.grouped(ti.ndrange(*((WIDTH,) * st.cfg.dim))):
+            st.implicit.conductance[I, o] = 0.0
+        kind = HeatNode.EMPTY
+        if nd.heat_capacity[I] > 0.0:
+            kind = HeatNode.FREE
+            fixed, Tw = fixed_temperature(st.cfg, I)
+            if fixed:
+                kind = HeatNode.FIXED
+        st.implicit.heat_node[I] = kind
+    point_loop(st, _conductance_body, True, False, True)
+
+
+@ti.func
+def finish(st: ti.template()):
+    """The explicit stages after the heat rate: node increments, the points' enthalpy."""
+    grid_update(st, True, False)
+    point_loop(st, _heat_body, True, False, False)
+
+
+def _row_neighbours(shape: tuple[int, ...], rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(neighbour flat index, valid) of each row node's WIDTH^dim slots, the last axis fastest
+    (the order of the conductance field's row)."""
+    coords = np.stack(np.unravel_index(rows, shape), axis=1)  # (rows, dim)
+    offsets = np.array(list(itertools.product(range(-REACH, REACH + 1), repeat=len(shape))))
+    nb = coords[:, None, :] + offsets[None, :, :]
+    valid = ((nb >= 0) & (nb < np.array(shape))).all(axis=2)
+    nb = np.where(valid[..., None], nb, 0)
+    return np.ravel_multi_index(tuple(np.moveaxis(nb, 2, 0)), shape), valid
+
+
+class StepHeat:
+    """The heat of one implicit step (module docstring): ``substeps`` explicit ones of
+    dt_heat, or (``cfg.heat_implicit``) one backward-Euler step of dt."""
+
+    def __init__(self, case: Case, st: State, substeps: int) -> None:
+        self.case = case
+        self.st = st
+        self.substeps = substeps  # 0: no heat
+        self.linear: LinearSolver | None = None
+
+    def set_step(self, dt: float, longest: float) -> None:
+        """A step of dt: dt_heat = dt (backward Euler), or the fewest substeps of at most
+        ``longest``."""
+        if self.substeps == 0:
+            return
+        if not self.st.cfg.heat_implicit:
+            self.substeps = max(1, math.ceil(dt / longest - 1e-9))
+        self.st.scalars.dt_heat[None] = dt / self.substeps
+
+    def advance(self) -> None:
+        """The step's heat, from the clock at the step's start (left there)."""
+        st = self.st
+        if self.substeps == 0:
+            return
+        if st.cfg.heat_implicit:
+            self._backward_euler()
+            return
+        t0 = float(st.scalars.t[None])
+        dt_heat = float(st.scalars.dt_heat[None])
+        for k in range(self.substeps):
+            st.scalars.t[None] = t0 + k * dt_heat
+            in_order(st, substep)
+        st.scalars.t[None] = t0
+
+    def _backward_euler(self) -> None:
+        st, nd = self.st, self.st.nodes
+        in_order(st, rates_and_conductance)
+        kind = st.implicit.heat_node.to_numpy().ravel()
+        capacity = nd.heat_capacity.to_numpy().ravel()
+        rate = nd.heat_rate.to_numpy()
+        shape = rate.shape
+        rate = rate.ravel()
+        rows = np.flatnonzero(kind != HeatNode.EMPTY)
+        cols, valid = _row_neighbours(shape, rows)
+        K = st.implicit.conductance.to_numpy().reshape(len(kind), -1)[rows]
+        keep = valid & (K != 0.0)
+        free = kind == HeatNode.FREE
+        unknown = np.full(len(kind), -1)
+        unknown[free] = np.arange(int(free.sum()))
+        keep &= free[cols]  # the columns of the unknowns only: fixed nodes do not change
+        r = np.repeat(np.arange(len(rows)), keep.sum(axis=1))
+        K_rows = sp.csr_matrix(
+            (K[keep], (r, unknown[cols[keep]])), shape=(len(rows), int(free.sum()))
+        )
+        is_free = free[rows]
+        dt = float(st.scalars.dt_heat[None])
+        A = (K_rows[is_free] + sp.diags(capacity[free] / dt)).tocsr()
+        how = linear_solver(self.case, A.shape[0])
+        if self.linear is None or self.linear.how != how:
+            self.linear = LinearSolver(how, HEAT_RTOL)
+        dT = self.linear.solve(A, rate[free]) if A.shape[0] else np.zeros(0)
+        rate[rows] -= K_rows @ dT
+        nd.heat_rate.from_numpy(rate.reshape(shape))
+        in_order(st, finish)
