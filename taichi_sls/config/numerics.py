@@ -133,8 +133,8 @@ class Time(Model):
     )
     dt_max_s: AutoPositive = Field(
         "auto",
-        description='adaptive: the largest step (s); "auto": none (the controls, the frames and the '
-        "laser switch times bound it)",
+        description='adaptive: the largest step (s); "auto": none (the controls, the frames '
+        "and the laser switch times bound it)",
     )
     max_temperature_change_K: float = Field(
         5.0,

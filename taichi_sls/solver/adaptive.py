@@ -14,17 +14,16 @@ time, nor a time the caller asks to land on (a frame). A step cut short to land 
 shrink the next one.
 """
 
-from __future__ import annotations
-
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import taichi as ti
 
 from ..config import Case
 from . import checkpoint
-from .fields import State
+from .fields import POINT_MEMBERS, State, struct_type
 from .guard import SimulationError
 from .implicit import ImplicitStepper, NewtonError
 from .step import init_box
@@ -45,24 +44,11 @@ class StepControls:
     strain: float
 
     @classmethod
-    def from_case(cls, case: Case, dt0: float) -> StepControls:
+    def from_case(cls, case: Case, dt0: float) -> "StepControls":
         t = case.time
         dt_min = dt0 / 1000.0 if t.dt_min_s == "auto" else float(t.dt_min_s)
         dt_max = math.inf if t.dt_max_s == "auto" else float(t.dt_max_s)
         return cls(dt_min, max(dt_max, dt_min), t.max_temperature_change_K, t.max_strain_increment)
-
-
-def step_changes(
-    T0: np.ndarray, T1: np.ndarray, F0: np.ndarray, F1: np.ndarray
-) -> tuple[float, float]:
-    """(dT, de): the largest temperature change (K) and strain increment |F1 F0^-1 - I| (F:
-    (points, dim, dim)) of any point over one step."""
-    dT = float(np.max(np.abs(T1 - T0), initial=0.0))
-    if len(F0) == 0:
-        return dT, 0.0
-    f = np.linalg.solve(np.swapaxes(F0, 1, 2), np.swapaxes(F1, 1, 2))  # (F1 F0^-1)^T
-    f -= np.eye(F0.shape[1])
-    return dT, float(np.sqrt(np.max(np.einsum("pij,pij->p", f, f))))
 
 
 def next_step(dt: float, ratio: float, controls: StepControls) -> float:
@@ -81,6 +67,24 @@ def laser_switch_times(case: Case) -> list[float]:
     return sorted(e for e in edges if e > 0.0)
 
 
+@ti.kernel
+def copy_points(src: ti.template(), dst: ti.template()):
+    for p in src:
+        dst[p] = src[p]
+
+
+@ti.kernel
+def step_changes(now: ti.template(), before: ti.template(), out: ti.template()):
+    """out = (dT, de): the largest temperature change (K) and strain increment
+    |F F_before^-1 - I| (Frobenius) of any point since ``before``."""
+    out[None] = ti.Vector([0.0, 0.0])
+    for p in now:
+        f = now[p].F @ before[p].F.inverse()
+        f -= ti.Matrix.identity(float, f.n)
+        ti.atomic_max(out[None][0], ti.abs(now[p].T - before[p].T))
+        ti.atomic_max(out[None][1], ti.sqrt((f * f).sum()))
+
+
 class AdaptiveStepper:
     """Implicit steps of a size chosen by :class:`StepControls` (module docstring).
     ``heat_step_max``: the longest heat substep (s), which sets the substeps of each step."""
@@ -96,6 +100,11 @@ class AdaptiveStepper:
         self.edges = laser_switch_times(case)
         self.last_dt = self.dt  # the last step taken
         self.refused = 0  # steps redone smaller, over the run
+        # the points before the step, on the device (a host copy cost a fifth of a step)
+        self.before = struct_type(POINT_MEMBERS, st.cfg.dim).field(
+            shape=st.n_points, layout=ti.Layout.SOA
+        )
+        self.changes = ti.Vector.field(2, float, ())
 
     def set_step(self, dt: float) -> None:
         """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
@@ -114,16 +123,16 @@ class AdaptiveStepper:
             t = float(st.scalars.t[None])
             dt = self._limit(t, t_end)
             cut = dt < self.dt
-            before = checkpoint.capture(st)
+            before = checkpoint.capture(st, points=False)
+            copy_points(st.points, self.before)
             self.set_step(dt)
             try:
                 self.implicit.step()
             except NewtonError as e:
                 self._redo(before, dt, SHRINK**0.5 * dt, str(e))
                 continue
-            dT, de = step_changes(
-                before["p_T"], st.points.T.to_numpy(), before["p_F"], st.points.F.to_numpy()
-            )
+            step_changes(st.points, self.before, self.changes)
+            dT, de = (float(x) for x in self.changes[None])
             ratio = max(dT / self.controls.temperature_K, de / self.controls.strain)
             if ratio > REDO and dt > self.controls.dt_min:
                 why = f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g})"
@@ -136,6 +145,7 @@ class AdaptiveStepper:
 
     def _redo(self, before: dict[str, np.ndarray], dt: float, smaller: float, why: str) -> None:
         """Put the state back and make the next try ``smaller``; below dt_min, give up."""
+        copy_points(self.before, self.st.points)
         checkpoint.restore(self.st, before)
         init_box(self.st)
         self.refused += 1

@@ -80,11 +80,12 @@ def load(st: State, path: Path, case_name: str) -> tuple[int, dict]:
     return int(z["steps"]), {k[2:]: z[k].item() for k in z.files if k.startswith("x_")}
 
 
-def capture(st: State) -> dict[str, np.ndarray]:
-    """The state a step changes, as host arrays (the points, the scalars, the kept node fields,
-    the blocks' ranges): what a checkpoint holds, and what the adaptive step restores to redo
-    a step it refused."""
-    data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in POINT_MEMBERS}
+def capture(st: State, points: bool = True) -> dict[str, np.ndarray]:
+    """The state a step changes, as host arrays (the points unless ``points`` is false, the
+    scalars, the kept node fields, the blocks' ranges): what a checkpoint holds, and with the
+    points kept on the device, what the adaptive step restores to redo a step it refused."""
+    members = POINT_MEMBERS if points else ()
+    data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in members}
     if st.blocks is not None:
         data["b_start"] = st.blocks.start.to_numpy()
         data["b_count"] = st.blocks.count.to_numpy()
@@ -95,8 +96,9 @@ def capture(st: State) -> dict[str, np.ndarray]:
 
 
 def restore(st: State, data: Mapping[str, np.ndarray]) -> None:
-    """Put back a state from :func:`capture` (or a checkpoint file's arrays)."""
-    for k in POINT_MEMBERS:
+    """Put back a state from :func:`capture` (or a checkpoint file's arrays); the points only
+    if it holds them."""
+    for k in POINT_MEMBERS if "p_x" in data else ():
         if f"p_{k}" in data or k not in LATER_MEMBERS:
             getattr(st.points, k).from_numpy(data[f"p_{k}"])
     for k in SCALARS:

@@ -8,7 +8,10 @@ configuration compiles it, 10-20 s, later calls load it) and compared with its r
   implicit at steps 10x and 100x the explicit capillary limit;
 - a second of viscous sintering of a PA12 pair (cases/verification/hopper_pa12.toml, out of the
   explicit integrator's reach: 3e8 steps) at R0/h = 10 and 20;
-- the paper's 25 W case (coarse grid, h = 4 um) to 1 ms: neck and peak temperature of both.
+- the paper's 25 W case to 1 ms (and, ``--refrozen``, until it has refrozen): explicit, implicit
+  at the "auto" step (coarse grid) and implicit with the adaptive step and backward-Euler heat,
+  on the coarse and the fine grid; neck and peak temperature against the explicit run, and the
+  stepping time of each (the main job's ``step_wall_s``: compilation and output excluded).
 
 Writes ``implicit.csv`` and ``implicit.json`` and prints the table.
 """
@@ -24,7 +27,7 @@ import time
 from pathlib import Path
 
 from ..config import load_case
-from ..solver.simulation import Simulation
+from ..jobs.case_run import complete_summary, run_case
 from ..solver.time_step import time_step_limits
 from . import verification as ver
 
@@ -82,34 +85,53 @@ def verification_rows(quick: bool) -> list[dict]:
     return out
 
 
-def paper_rows(end_s: float = 1e-3) -> list[dict]:
-    """The 25 W pair on the coarse grid to end_s: neck and peak temperature, both integrators."""
+# the 25 W pair by each integrator: (case, label, overrides)
+ADAPTIVE = ["time.integrator=implicit", "time.adaptive=true", "time.heat_integrator=implicit"]
+PAPER_RUNS = (
+    ("power25W_coarse", "explicit", ["time.dt_s=auto"]),
+    ("power25W_coarse", "implicit", ["time.integrator=implicit", "time.dt_s=auto"]),
+    ("power25W_coarse", "implicit, adaptive", ADAPTIVE),
+    ("power25W", "explicit", []),
+    ("power25W", "implicit, adaptive", ADAPTIVE),
+)
+
+
+def paper_rows(runs_dir: Path, refrozen: bool, end_s: float = 1e-3) -> list[dict]:
+    """The 25 W pair to end_s (and, ``refrozen``, until it has refrozen) by each integrator as
+    the main job runs it (no images): neck and peak temperature against the explicit run on
+    the same grid, the stepping time alone (compilation and output excluded)."""
     out = []
-    for integrator in ("explicit", "implicit"):
-        case = load_case("power25W_coarse", [f"time.integrator={integrator}", "time.dt_s=auto"])
-        t0 = time.perf_counter()
-        sim = Simulation(case)
-        n = int(round(end_s / sim.dt))
-        sim.advance(n)
-        wall = time.perf_counter() - t0
-        mon = sim.monitors()
-        for measure in ("contact_line_um", "T_peak_C"):
-            out.append(
-                {
-                    "row": f"power25W_coarse to {end_s:g} s",
-                    "integrator": integrator,
-                    "dt_s": sim.dt,
-                    "steps": n,
-                    "wall_s": round(wall, 2),
-                    "measure": measure,
-                    "value": mon[measure],
-                    "error": math.nan,
-                }
-            )
-        print(out[-2:], file=sys.stderr, flush=True)
-    explicit = {r["measure"]: r["value"] for r in out if r["integrator"] == "explicit"}
-    for r in out:
-        r["error"] = r["value"] / explicit[r["measure"]] - 1.0  # against the explicit run
+    stops = [("1 ms", [f"time.end_s={end_s}"])]
+    if refrozen:
+        stops.append(("refrozen", ["time.stop=solidified"]))
+    for stop, stop_sets in stops:
+        for name, label, sets in PAPER_RUNS:
+            case = load_case(name, [*sets, *stop_sets, "output.png=false", "output.gif=false"])
+            folder = runs_dir / f"{name}_{stop}_{label}".replace(" ", "_").replace(",", "")
+            summary = complete_summary(folder) or run_case(case, folder, progress=False)
+            for measure in ("contact_line_um", "T_peak_C"):
+                out.append(
+                    {
+                        "row": f"{name} to {stop}",
+                        "integrator": label,
+                        "dt_s": summary["dt_s"],
+                        "steps": summary["steps"],
+                        "wall_s": round(summary["step_wall_s"], 2),
+                        "measure": measure,
+                        "value": summary["final"][measure],
+                        "error": math.nan,
+                    }
+                )
+            print(out[-2:], file=sys.stderr, flush=True)
+    for r in out:  # against the explicit run of the same grid and end
+        ref = next(
+            q
+            for q in out
+            if q["row"] == r["row"]
+            and q["integrator"] == "explicit"
+            and q["measure"] == r["measure"]
+        )
+        r["error"] = r["value"] / ref["value"] - 1.0
     return out
 
 
@@ -117,13 +139,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap = sub.add_parser("implicit", help="explicit and implicit integrators side by side")
     ap.add_argument("--out", default="renders", help="folder for implicit.csv and .json")
     ap.add_argument("--quick", action="store_true", help="fewer Hopper rows")
+    ap.add_argument(
+        "--refrozen", action="store_true", help="the 25 W runs also until refrozen (some 10 min)"
+    )
+    ap.add_argument("--runs", default="out/bench_implicit", help="folder of the 25 W runs")
     ap.set_defaults(func=main)
 
 
 def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    rows = verification_rows(args.quick) + paper_rows()
+    rows = verification_rows(args.quick) + paper_rows(Path(args.runs), args.refrozen)
     with (out / "implicit.csv").open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()

@@ -73,7 +73,13 @@ def compare(out_dir: Path, align_s: float = ALIGN_S) -> list[dict]:
             "difference": float(n / p - 1.0) if p == p else math.nan,
         }
         for t, dt, T, f, n, p in zip(
-            s["t_s"], s["dt_s"], s["T_mean_C"], s["molten_fraction"], s["contact_line_um"], pred
+            s["t_s"],
+            s["dt_s"],
+            s["T_mean_C"],
+            s["molten_fraction"],
+            s["contact_line_um"],
+            pred,
+            strict=True,
         )
     ]
 
@@ -89,9 +95,7 @@ def plot(rows: list[dict], path: Path) -> None:
     keep = t > 0
     fig, (a, b) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True)
     a.semilogx(t[keep], [r["neck_um"] for r in rows if r["t_s"] > 0], "o-", ms=3, label="run")
-    a.semilogx(
-        t[keep], [r["hopper_neck_um"] for r in rows if r["t_s"] > 0], "k--", label="Hopper"
-    )
+    a.semilogx(t[keep], [r["hopper_neck_um"] for r in rows if r["t_s"] > 0], "k--", label="Hopper")
     a.set_ylabel("neck (um)")
     a.legend(title="at the recorded temperature")
     b.semilogx(t[keep], [r["T_mean_C"] for r in rows if r["t_s"] > 0], "r-")
@@ -131,10 +135,12 @@ def main(args: argparse.Namespace) -> int:
     t = np.array([r["t_s"] for r in rows])
     for ts in REPORT_S:
         if ts <= t[-1] * (1 + 1e-9):
-            k = int(np.argmin(np.abs(t - ts)))
-            r = rows[k]
+            T, neck, hopper = (
+                float(np.interp(ts, t, [r[k] for r in rows]))
+                for k in ("T_mean_C", "neck_um", "hopper_neck_um")
+            )
             print(
-                f"t = {r['t_s']:.3g} s: T_mean {r['T_mean_C']:.1f} C, neck {r['neck_um']:.2f} um, "
-                f"Hopper {r['hopper_neck_um']:.2f} um ({r['difference']:+.2%})"
+                f"t = {ts:g} s: T_mean {T:.1f} C, neck {neck:.2f} um, Hopper {hopper:.2f} um "
+                f"({neck / hopper - 1:+.2%})"
             )
     return 0

@@ -15,10 +15,12 @@ from taichi_sls.solver.adaptive import (
     SAFETY,
     SHRINK,
     StepControls,
+    copy_points,
     laser_switch_times,
     next_step,
     step_changes,
 )
+from taichi_sls.solver.fields import POINT_MEMBERS, struct_type
 from taichi_sls.solver.guard import SimulationError
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.solver.time_step import heat_step_max
@@ -40,15 +42,24 @@ def test_next_step_follows_the_controls():
 
 def test_step_changes_measure_temperature_and_strain():
     """The strain increment is |F1 F0^-1 - I|: blind to the deformation a point already has
-    (a rotated, stretched F0), equal to the step's own increment."""
+    (a rotated, stretched F0), equal to the step's own increment; the temperature change is the
+    largest of any point."""
+    sim = Simulation(load_case("power25W_coarse", ADAPTIVE))
+    n = sim.state.n_points
     rng = np.random.default_rng(3)
     c, s = np.cos(0.7), np.sin(0.7)
     F0 = np.array([[c, -s], [s, c]]) @ np.diag([1.5, 0.6])
     e = 0.01 * rng.normal(size=(2, 2))
-    F1 = (np.eye(2) + e) @ F0
-    dT, de = step_changes(
-        np.array([300.0, 310.0]), np.array([301.0, 307.5]), np.stack([F0, F0]), np.stack([F0, F1])
-    )
+    F = np.repeat(F0[None], n, axis=0)
+    T = np.full(n, 400.0)
+    sim.adaptive.before.F.from_numpy(F)
+    sim.adaptive.before.T.from_numpy(T)
+    F[7] = (np.eye(2) + e) @ F0
+    T[11] -= 2.5
+    sim.state.points.F.from_numpy(F)
+    sim.state.points.T.from_numpy(T)
+    step_changes(sim.state.points, sim.adaptive.before, sim.adaptive.changes)
+    dT, de = sim.adaptive.changes[None]
     assert dT == pytest.approx(2.5)
     assert de == pytest.approx(np.linalg.norm(e), rel=1e-10)
 
@@ -76,13 +87,17 @@ def test_adaptive_input_errors_name_the_key(sets, key):
 
 
 def test_a_redone_step_starts_from_the_state_before_it():
-    """checkpoint.capture holds everything a step reads: steps taken after a restore repeat
-    the first ones bit for bit (serial layout)."""
+    """What the adaptive step keeps before a step (the points on the device, the rest by
+    checkpoint.capture) is everything a step reads: steps taken after a restore repeat the
+    first ones bit for bit (serial layout)."""
     sim = Simulation(load_case("power25W_coarse", [*ADAPTIVE, "solver.layout=serial"]))
     sim.advance(2)
-    before, dt_next = checkpoint.capture(sim.state), sim.adaptive.dt
+    before, dt_next = checkpoint.capture(sim.state, points=False), sim.adaptive.dt
+    kept = struct_type(POINT_MEMBERS, 2).field(shape=sim.state.n_points)
+    copy_points(sim.state.points, kept)
     sim.advance(3)
     first = sim.state.points.to_numpy()
+    copy_points(kept, sim.state.points)
     checkpoint.restore(sim.state, before)
     sim.adaptive.dt = dt_next
     sim.advance(3)

@@ -1,0 +1,47 @@
+"""The seconds a melt lives (cases/sinter_hold.toml, studies/sinter_hold.py): a laser-melted pair
+held on a bed between PA12's crystallisation and melting ranges stays molten and sinters as
+Hopper's solution says at the temperature the run records."""
+
+import numpy as np
+import pytest
+
+from taichi_sls.config import load_case
+from taichi_sls.jobs.case_run import run_case
+from taichi_sls.studies import references as ref
+from taichi_sls.studies.sinter_hold import compare, hopper_at_history
+
+
+def test_hopper_at_a_constant_temperature_is_hoppers_clock():
+    """At a constant temperature the integrated clock is gamma t / (eta_N R0): a neck history
+    taken from Hopper's solution itself is predicted back to round-off from any alignment."""
+    m = load_case("sinter_hold").materials["PA12"]
+    R0 = 20.0
+    eta_N = 0.5 * m.viscosity_A_Pas * np.exp(-m.viscosity_b_1_C * 170.0)
+    t = np.linspace(0.0, 1.0, 201)
+    tau = 0.1 + m.surface_tension_N_m * t / (eta_N * R0 * 1e-6)
+    neck = 2.0 * R0 * ref.hopper_neck_at(tau)
+    pred = hopper_at_history(t, np.full_like(t, 170.0), neck, m, R0, align_s=0.25)
+    after = t >= 0.25
+    assert np.isnan(pred[~after]).all()
+    assert np.allclose(pred[after], neck[after], rtol=1e-9)
+
+
+def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path):
+    """The bundled case to 0.3 s (the implicit integrator, adaptive steps, backward-Euler heat):
+    the pulse melts the pair, it cools to the 170 C bed and stays molten (it crystallises only
+    below 150 C), and from 0.1 s on its neck is Hopper's at the recorded temperature within the
+    issue's 3 % (measured +1.5 / +0.9 / -0.8 % at 0.1 / 0.16 / 0.25 s); the neck has grown by
+    half."""
+    case = load_case("sinter_hold", ["time.end_s=0.3", "output.png=false", "output.gif=false"])
+    summary = run_case(case, tmp_path, progress=False)
+    assert summary["status"] == "complete"
+    rows = compare(tmp_path)
+    last = rows[-1]
+    assert last["t_s"] == pytest.approx(0.3)
+    assert last["molten_fraction"] == 1.0
+    assert last["T_mean_C"] == pytest.approx(170.0, abs=0.01)
+    late = [r for r in rows if r["t_s"] >= 0.1]
+    assert len(late) >= 3
+    print("neck against Hopper:", [(r["t_s"], r["difference"]) for r in late])
+    assert all(abs(r["difference"]) < 0.03 for r in late)
+    assert last["neck_um"] > 1.5 * rows[0]["neck_um"]
