@@ -70,12 +70,21 @@ class Time(Model):
         description="heat step as a fraction of the thermal stability limit for heat_every = "
         '"auto"',
     )
-    integrator: Literal["explicit", "implicit"] = Field(
+    integrator: Literal["explicit", "implicit", "hybrid"] = Field(
         "explicit",
         description="explicit: the paper's step (eqs. 10-18), bounded by the elastic, capillary "
         "and viscous limits; implicit: backward Euler for the grid velocities (Newton on the "
         "momentum balance with the Perzyna update's secant tangent, the capillary force "
-        "semi-implicit), bounded by the heat step only (docs/implicit.md)",
+        "semi-implicit), bounded by the heat step only (docs/implicit.md); hybrid: explicit "
+        "steps of dt_s through the laser pulse and the melting collapse, then adaptive implicit "
+        "ones once every laser is off and the kinetic energy is below "
+        "handover_kinetic_fraction of the surface energy (solver/handover.py)",
+    )
+    handover_kinetic_fraction: float = Field(
+        1e-5,
+        gt=0,
+        description="hybrid: the kinetic energy (times solver.mass_scale), as a fraction of gamma "
+        "times the bodies' perimeter, below which the implicit step takes over",
     )
     implicit_step_factor: float = Field(
         50.0,

@@ -186,7 +186,7 @@ class Case(Model):
                 '(solver.stress_reading = "paper") exists in the total form only'
             )
         if (
-            self.time.integrator == "implicit"
+            self.time.integrator != "explicit"
             and self.physics.surface_tension
             and self.surface_tension.method != "surface_energy"
         ):
@@ -195,7 +195,7 @@ class Case(Model):
                 "integrator linearises the surface-energy force only (allowed with it: "
                 '"surface_energy")'
             )
-        if self.time.integrator == "implicit" and self.solver.update != "usl":
+        if self.time.integrator != "explicit" and self.solver.update != "usl":
             raise CaseError(
                 f"solver.update = {self.solver.update!r}: the implicit integrator moves the "
                 'points with its converged grid velocity (allowed with it: "usl")'
@@ -222,7 +222,7 @@ class Case(Model):
     def implicit_mechanics(self) -> bool:
         """Whether the mechanics steps implicitly (``time.integrator``; without mechanics there
         is nothing to step)."""
-        return self.time.integrator == "implicit" and self.physics.mechanics
+        return self.time.integrator != "explicit" and self.physics.mechanics
 
     def lasers_off_s(self) -> float:
         """The time after which no laser heats (s): switched off, or scanned past x_end_um."""

@@ -264,6 +264,7 @@ def run_case(
             steps_per_s=(sim.steps - steps0) / step_wall if step_wall > 0 else math.nan,
             final=last,
             refused_steps=sim.adaptive.refused if sim.adaptive is not None else 0,
+            handover_s=sim.handover.at_s if sim.handover is not None else None,
             T_peak_C=last.get("T_peak_C"),
             warnings=list(dict.fromkeys(warnings)),
         )

@@ -15,12 +15,13 @@ from ..physics.materials import KELVIN
 from . import checkpoint
 from .adaptive import AdaptiveStepper
 from .blocks import BlockPlan
-from .contacts import neck_width, point_colour, touching
+from .contacts import touching
 from .fields import State
-from .grid_views import colour_only, level_set_only
 from .guard import Guard
+from .handover import Handover, explicit_view
 from .implicit import ImplicitStepper
-from .monitor import neck_measures, point_monitors
+from .monitor import point_monitors
+from .necks import NeckMeasures
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
 from .step import advance, init_box
@@ -58,7 +59,7 @@ def init_taichi(
     )
 
 
-class Simulation:
+class Simulation(NeckMeasures):
     """One case on the device: ``advance(n)`` steps, ``monitors()`` reads (and guards) the
     state, ``snapshot()`` gives the points for output.
 
@@ -110,17 +111,22 @@ class Simulation:
         self.state.scalars.dt[None] = self.dt
         init_box(self.state)
         self.steps = 0
-        self.implicit = self.adaptive = None
+        self.implicit = self.adaptive = self.handover = None
+        hybrid = case.time.integrator == "hybrid"
         if cfg.implicit:
             self.state.scalars.dt_heat[None] = dt_heat
             self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
-            if case.time.adaptive:
+            if case.time.adaptive or hybrid:  # hybrid: from implicit_step_factor x its dt
+                dt0 = self.dt * (case.time.implicit_step_factor if hybrid else 1.0)
                 longest = heat_step_max(case)
-                self.adaptive = AdaptiveStepper(case, self.state, self.implicit, self.dt, longest)
+                self.adaptive = AdaptiveStepper(case, self.state, self.implicit, dt0, longest)
+        if hybrid:
+            view = explicit_view(case, self.state, self.scene, self.dt)
+            self.handover = Handover(case, view, self.adaptive, self.dt, self.kinetic_ratio)
         t0 = time.perf_counter()
-        if self.implicit is None:
-            advance(self.state, 0)  # compiles the step kernel
-        else:
+        if self.implicit is None or hybrid:
+            advance(self.explicit_state, 0)  # compiles the explicit step kernel
+        if self.implicit is not None:
             self.implicit.compile()
         self.compile_s = time.perf_counter() - t0
         self._mass = self.state.points.mass.to_numpy()
@@ -152,9 +158,19 @@ class Simulation:
         return float(self.state.scalars.t[None])
 
     @property
+    def explicit_state(self) -> State:
+        """The state as the explicit step sees it (hybrid: its own view of the fields)."""
+        return self.state if self.handover is None else self.handover.view
+
+    @property
+    def explicit_now(self) -> bool:
+        """Whether the next step is explicit."""
+        return self.implicit is None or (self.handover is not None and self.handover.explicit)
+
+    @property
     def step_dt(self) -> float:
-        """The last step taken (s): ``dt`` but with ``time.adaptive``."""
-        return self.dt if self.adaptive is None else self.adaptive.last_dt
+        """The last step taken (s): ``dt`` but with ``time.adaptive`` or after a hand-over."""
+        return self.dt if self.adaptive is None or self.explicit_now else self.adaptive.last_dt
 
     def advance_to(self, t: float) -> None:
         """Advance until the clock reaches t (s): adaptive steps that land on it, or the whole
@@ -162,28 +178,49 @@ class Simulation:
         if self.adaptive is None:
             self.advance(round((t - self.t) / self.dt))
             return
-        self.steps += self.adaptive.advance_to(t, self._after_step)
+        while self.explicit_now and (n := round((t - self.t) / self.dt)) > 0:
+            self._explicit_steps(n)
+        if not self.explicit_now:
+            self.steps += self.adaptive.advance_to(t, self._after_step)
+
+    def kinetic_ratio(self) -> float:
+        """The kinetic energy (times the inertia scale) over the surface energy."""
+        ke = point_monitors(self.state)[0]["kinetic_energy_J_per_m"]
+        return self.case.solver.mass_scale * ke / self.surface_energy()
 
     def _after_step(self) -> None:
         if self.blocks is not None and self.blocks.needs_sort[None]:
             self.sort_points()
 
     def advance(self, n: int) -> None:
-        """Advance n steps."""
+        """Advance n steps (hybrid: explicit ones up to the hand-over, then implicit ones)."""
+        while n > 0 and self.handover is not None and self.handover.explicit:
+            n -= self._explicit_steps(n)
+        stepper = self.adaptive or self.implicit
+        self._advance(advance if stepper is None else lambda st, k: stepper.advance(k), None, n)
+
+    def _explicit_steps(self, n: int) -> int:
+        """Hybrid: explicit steps, at most n, up to the next check of the hand-over."""
+        k = min(n, self.handover.steps_to_check(self.steps))
+        self._advance(advance, self.handover.view, k)
+        self.handover.check(self.t, self.steps)
+        return k
+
+    def _advance(self, step: Callable, state: State | None, n: int) -> None:
+        """n steps of ``step(state, n)`` (default state: the run's), sorting the blocks."""
         if n <= 0:
             return
-        stepper = self.adaptive or self.implicit
-        step = advance if stepper is None else lambda st, k: stepper.advance(k)
+        state = state or self.state
         if self.before_step is not None:
             for _ in range(n):
                 self.before_step(self)
-                step(self.state, 1)
+                step(state, 1)
         elif self.blocks is not None:
             for _ in range(n):  # a point that drifted out of its block: sort them again
-                step(self.state, 1)
+                step(state, 1)
                 self._after_step()
         else:
-            step(self.state, n)
+            step(state, n)
         self.steps += n
 
     def sort_points(self) -> None:
@@ -204,123 +241,6 @@ class Simulation:
         self.point_order = self.point_order[order]
 
     # ------------------------------------------------------------------ monitors
-    def phi(self) -> np.ndarray:
-        """Level set of eq. 21 on the nodes (m) of the current points."""
-        level_set_only(self.state)
-        return self.state.nodes.phi.to_numpy()
-
-    def colour(self) -> np.ndarray:
-        """The surface-energy colour c_i of the current points on the nodes (the contoured
-        one: filtered when the case filters it)."""
-        colour_only(self.state)
-        return self.state.nodes.colour.to_numpy()
-
-    def neck_measure(self) -> str:
-        """The interface the contact line is read on: the force's own (``output.neck_measure =
-        "auto"``: the colour for the surface-energy force, eq. 21 for the CSF and for frozen
-        points), or the one the case names."""
-        m = self.case.output.neck_measure
-        if m == "auto":
-            energy = self.case.surface_tension.method == "surface_energy"
-            m = "colour" if energy and self.case.physics.mechanics else "level_set"
-        return m
-
-    def contact_line_m(self, measure: str | None = None) -> tuple[float, float]:
-        """(contact line, neck span) in metres of the first contact (the paper's pair) on
-        ``measure`` (default: :meth:`neck_measure`), sectioned as ``contact.neck_section`` says
-        (:meth:`necks_m`; the column: :mod:`taichi_sls.solver.monitor`)."""
-        if not self._pair:
-            return float("nan"), float("nan")
-        measure = measure or self.neck_measure()
-        if self.case.contact.neck_section == "centres":
-            if not self.contacts:
-                return 0.0, 0.0
-            w = self.necks_m(measure)[0]
-            return w, w
-        lo, hi = sorted(self.body_centres_m()[:2, 0])
-        cfg = self.state.cfg
-        return neck_measures(-self._material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
-
-    def raw_colour(self) -> np.ndarray:
-        """The colour c_i of the current points before any filter: the cell fraction that
-        material fills, from the node mass (or volume, as the case's force takes it)."""
-        self.colour()  # the grid's mass and volume of the current points
-        cfg, nd = self.state.cfg, self.state.nodes
-        if cfg.se.volume_colour:
-            return nd.volume.to_numpy() / cfg.cell_volume
-        return nd.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
-
-    def _material_field(self, measure: str, section: str) -> np.ndarray:
-        """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
-        c - 1/2 of the colour. The sections across the centres read the raw colour: they are
-        blind to the hole that the force's filter is there to close, and the filter's
-        smoothing would widen a concave neck by about kappa h^2. The column reads the colour
-        the force contours."""
-        if measure != "colour":
-            return -self.phi()
-        return (self.raw_colour() if section == "centres" else self.colour()) - 0.5
-
-    def necks_m(self, measure: str | None = None) -> list[float]:
-        """The neck of every contact (m), in the order of ``contacts``: the narrowest section
-        across the line of the two bodies' mass centres, between the outermost crossings of the
-        interface (:func:`taichi_sls.solver.contacts.neck_width`)."""
-        if not self.contacts:
-            return []
-        field = self._material_field(measure or self.neck_measure(), "centres")
-        centre = self.body_centres_m()
-        cfg = self.state.cfg
-        out = []
-        for a, b in self.contacts:
-            reach = min(self._body_radius[a], self._body_radius[b])
-            out.append(neck_width(field, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
-        return out
-
-    @property
-    def body_radii_m(self) -> np.ndarray:
-        """Each body's equivalent radius sqrt(area / pi) as seeded (m): its reach for a neck."""
-        return self._body_radius
-
-    def body_centres_m(self, initial: bool = False) -> np.ndarray:
-        """Each body's mass centre (m), (bodies, 2): of the current points, or (``initial``) of
-        their start positions."""
-        pt = self.state.points
-        x = (pt.x0 if initial else pt.x).to_numpy()
-        body, m = self.scene.body, self._mass
-        n_b = len(self._body_radius)
-        return (
-            np.stack(
-                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
-            )
-            / np.bincount(body, weights=m, minlength=n_b)[:, None]
-        )
-
-    def pair_necks_m(self) -> list[float]:
-        """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
-        reads it but on the raw colour of the contact's two bodies alone: in a bed a section
-        across one contact also crosses the neighbours, whose material the outermost crossings
-        would count. Mass colour m_i / (rho V_cell), or the volume colour where the force uses
-        it; equal to :meth:`necks_m` on the colour for a case of two bodies."""
-        if not self.contacts:
-            return []
-        pt, cfg = self.state.points, self.state.cfg
-        x = pt.x.to_numpy()
-        if cfg.se.volume_colour:
-            weight = pt.volume0.to_numpy() * pt.J.to_numpy() / cfg.cell_volume
-        else:
-            weight = self._mass / (cfg.rho_ref * cfg.cell_volume)
-        body = self.scene.body
-        order = np.argsort(body, kind="stable")
-        bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
-        members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
-        centre = self.body_centres_m()
-        shape = (cfg.nx, cfg.ny)
-        out = []
-        for a, b in self.contacts:
-            sel = np.concatenate([members[a], members[b]])
-            c = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
-            reach = min(self._body_radius[a], self._body_radius[b])
-            out.append(neck_width(c, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
-        return out
 
     def monitors(self, guard: bool = True) -> dict[str, float]:
         """Monitored quantities (SI, temperatures in C, lengths in um); runs the guard unless

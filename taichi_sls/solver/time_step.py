@@ -37,8 +37,8 @@ def resolve_dt(case: Case) -> tuple[float, dict[str, float]]:
     thermal limit can be the smallest, and a heat step near it overshoots); a fixed dt above the
     smallest limit is refused unless ``time.allow_unstable_dt``."""
     limits = time_step_limits(case)
-    if case.implicit_mechanics():
-        return _implicit_dt(case, limits)
+    if case.implicit_mechanics() and case.time.integrator == "implicit":
+        return _implicit_dt(case, limits)  # hybrid: dt_s is its explicit phase's step
     bound = min(limits.values()) if limits else case.time.end_s
     if case.time.dt_s == "auto":
         dt = case.time.safety * bound

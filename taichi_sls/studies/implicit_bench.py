@@ -91,8 +91,10 @@ PAPER_RUNS = (
     ("power25W_coarse", "explicit", ["time.dt_s=auto"]),
     ("power25W_coarse", "implicit", ["time.integrator=implicit", "time.dt_s=auto"]),
     ("power25W_coarse", "implicit, adaptive", ADAPTIVE),
+    ("power25W_coarse", "hybrid", ["time.integrator=hybrid", "time.heat_integrator=implicit"]),
     ("power25W", "explicit", []),
     ("power25W", "implicit, adaptive", ADAPTIVE),
+    ("power25W", "hybrid", ["time.integrator=hybrid", "time.heat_integrator=implicit"]),
 )
 
 

@@ -1,0 +1,131 @@
+"""The interface and neck measures of a simulation (a mixin of :class:`Simulation`): the level
+set and colour on the nodes, the contact line of the paper's pair, the neck of every contact."""
+
+import numpy as np
+
+from .contacts import neck_width, point_colour
+from .grid_views import colour_only, level_set_only
+from .monitor import neck_measures
+
+
+class NeckMeasures:
+    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass`` and
+    ``_body_radius`` (set by :class:`Simulation`)."""
+
+    def phi(self) -> np.ndarray:
+        """Level set of eq. 21 on the nodes (m) of the current points."""
+        level_set_only(self.state)
+        return self.state.nodes.phi.to_numpy()
+
+    def colour(self) -> np.ndarray:
+        """The surface-energy colour c_i of the current points on the nodes (the contoured
+        one: filtered when the case filters it)."""
+        colour_only(self.state)
+        return self.state.nodes.colour.to_numpy()
+
+    def neck_measure(self) -> str:
+        """The interface the contact line is read on: the force's own (``output.neck_measure =
+        "auto"``: the colour for the surface-energy force, eq. 21 for the CSF and for frozen
+        points), or the one the case names."""
+        m = self.case.output.neck_measure
+        if m == "auto":
+            energy = self.case.surface_tension.method == "surface_energy"
+            m = "colour" if energy and self.case.physics.mechanics else "level_set"
+        return m
+
+    def contact_line_m(self, measure: str | None = None) -> tuple[float, float]:
+        """(contact line, neck span) in metres of the first contact (the paper's pair) on
+        ``measure`` (default: :meth:`neck_measure`), sectioned as ``contact.neck_section`` says
+        (:meth:`necks_m`; the column: :mod:`taichi_sls.solver.monitor`)."""
+        if not self._pair:
+            return float("nan"), float("nan")
+        measure = measure or self.neck_measure()
+        if self.case.contact.neck_section == "centres":
+            if not self.contacts:
+                return 0.0, 0.0
+            w = self.necks_m(measure)[0]
+            return w, w
+        lo, hi = sorted(self.body_centres_m()[:2, 0])
+        cfg = self.state.cfg
+        return neck_measures(-self._material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
+
+    def raw_colour(self) -> np.ndarray:
+        """The colour c_i of the current points before any filter: the cell fraction that
+        material fills, from the node mass (or volume, as the case's force takes it)."""
+        self.colour()  # the grid's mass and volume of the current points
+        cfg, nd = self.state.cfg, self.state.nodes
+        if cfg.se.volume_colour:
+            return nd.volume.to_numpy() / cfg.cell_volume
+        return nd.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
+
+    def _material_field(self, measure: str, section: str) -> np.ndarray:
+        """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
+        c - 1/2 of the colour. The sections across the centres read the raw colour: they are
+        blind to the hole that the force's filter is there to close, and the filter's
+        smoothing would widen a concave neck by about kappa h^2. The column reads the colour
+        the force contours."""
+        if measure != "colour":
+            return -self.phi()
+        return (self.raw_colour() if section == "centres" else self.colour()) - 0.5
+
+    def necks_m(self, measure: str | None = None) -> list[float]:
+        """The neck of every contact (m), in the order of ``contacts``: the narrowest section
+        across the line of the two bodies' mass centres, between the outermost crossings of the
+        interface (:func:`taichi_sls.solver.contacts.neck_width`)."""
+        if not self.contacts:
+            return []
+        field = self._material_field(measure or self.neck_measure(), "centres")
+        centre = self.body_centres_m()
+        cfg = self.state.cfg
+        out = []
+        for a, b in self.contacts:
+            reach = min(self._body_radius[a], self._body_radius[b])
+            out.append(neck_width(field, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
+        return out
+
+    @property
+    def body_radii_m(self) -> np.ndarray:
+        """Each body's equivalent radius sqrt(area / pi) as seeded (m): its reach for a neck."""
+        return self._body_radius
+
+    def body_centres_m(self, initial: bool = False) -> np.ndarray:
+        """Each body's mass centre (m), (bodies, 2): of the current points, or (``initial``) of
+        their start positions."""
+        pt = self.state.points
+        x = (pt.x0 if initial else pt.x).to_numpy()
+        body, m = self.scene.body, self._mass
+        n_b = len(self._body_radius)
+        return (
+            np.stack(
+                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
+            )
+            / np.bincount(body, weights=m, minlength=n_b)[:, None]
+        )
+
+    def pair_necks_m(self) -> list[float]:
+        """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
+        reads it but on the raw colour of the contact's two bodies alone: in a bed a section
+        across one contact also crosses the neighbours, whose material the outermost crossings
+        would count. Mass colour m_i / (rho V_cell), or the volume colour where the force uses
+        it; equal to :meth:`necks_m` on the colour for a case of two bodies."""
+        if not self.contacts:
+            return []
+        pt, cfg = self.state.points, self.state.cfg
+        x = pt.x.to_numpy()
+        if cfg.se.volume_colour:
+            weight = pt.volume0.to_numpy() * pt.J.to_numpy() / cfg.cell_volume
+        else:
+            weight = self._mass / (cfg.rho_ref * cfg.cell_volume)
+        body = self.scene.body
+        order = np.argsort(body, kind="stable")
+        bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
+        members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
+        centre = self.body_centres_m()
+        shape = (cfg.nx, cfg.ny)
+        out = []
+        for a, b in self.contacts:
+            sel = np.concatenate([members[a], members[b]])
+            c = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
+            reach = min(self._body_radius[a], self._body_radius[b])
+            out.append(neck_width(c, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
+        return out
