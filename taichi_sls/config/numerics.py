@@ -150,6 +150,13 @@ class Time(Model):
         gt=0,
         description="adaptive: the largest temperature change of any point in one step (K)",
     )
+    max_motion_cells: float = Field(
+        0.25,
+        gt=0,
+        lt=0.5,
+        description="adaptive: the farthest any point may move in one step, in cells (the "
+        "guard refuses half a cell)",
+    )
     max_strain_increment: float = Field(
         0.02,
         gt=0,

@@ -1,13 +1,15 @@
 """The step chosen by the physics (``time.adaptive``; the implicit integrator only).
 
 Each step is taken with the current dt and then measured: the largest temperature change of any
-point, dT, and the largest strain increment, de = |f - I| (Frobenius; f = F^{n+1} (F^n)^-1, the
-step's deformation gradient). Against the case's controls, r = max(dT / dT_max, de / de_max),
-and the next step follows as for a first-order method, whose error per step grows with dt:
-dt_next = SAFETY dt / r, at most GROWTH and at least SHRINK times the last, within
-[dt_min, dt_max]. So the step grows while nothing changes fast (laser off, the melt settled) and
-shrinks through the pulse and the melting and freezing fronts. A step with r > REDO (twice over
-its controls) or whose Newton failed is redone from the state before it at a smaller step.
+point, dT, the largest strain increment, de = |f - I| (Frobenius; f = F^{n+1} (F^n)^-1, the
+step's deformation gradient), and the farthest motion of a point, dx (or its velocity times
+dt, which the guard limits). Against the case's
+controls, r = max(dT / dT_max, de / de_max, dx / (cells h)), and the next step follows as for a
+first-order method, whose error per step grows with dt: dt_next = SAFETY dt / r, at most GROWTH
+and at least SHRINK times the last, within [dt_min, dt_max]. So the step grows while nothing
+changes fast (laser off, the melt settled) and shrinks through the pulse and the melting and
+freezing fronts. A step with r > REDO (twice over its controls) or whose Newton failed is redone
+from the state before it at a smaller step.
 
 A step never crosses a laser's switch-on or switch-off time, so the pulse starts and stops on
 time, nor a time the caller asks to land on (a frame). A step cut short to land there does not
@@ -42,13 +44,20 @@ class StepControls:
     dt_max: float
     temperature_K: float
     strain: float
+    cells: float
 
     @classmethod
     def from_case(cls, case: Case, dt0: float) -> "StepControls":
         t = case.time
         dt_min = dt0 / 1000.0 if t.dt_min_s == "auto" else float(t.dt_min_s)
         dt_max = math.inf if t.dt_max_s == "auto" else float(t.dt_max_s)
-        return cls(dt_min, max(dt_max, dt_min), t.max_temperature_change_K, t.max_strain_increment)
+        return cls(
+            dt_min,
+            max(dt_max, dt_min),
+            t.max_temperature_change_K,
+            t.max_strain_increment,
+            t.max_motion_cells,
+        )
 
 
 def next_step(dt: float, ratio: float, controls: StepControls) -> float:
@@ -74,15 +83,19 @@ def copy_points(src: ti.template(), dst: ti.template()):
 
 
 @ti.kernel
-def step_changes(now: ti.template(), before: ti.template(), out: ti.template()):
-    """out = (dT, de): the largest temperature change (K) and strain increment
-    |F F_before^-1 - I| (Frobenius) of any point since ``before``."""
-    out[None] = ti.Vector([0.0, 0.0])
+def step_changes(now: ti.template(), before: ti.template(), out: ti.template(), dt: float):
+    """out = (dT, de, dx): the largest temperature change (K), strain increment
+    |F F_before^-1 - I| (Frobenius) and motion (m) of any point over the step dt since
+    ``before``; the motion also as the point's own velocity times dt, which the guard limits
+    (with FLIP it is not the grid velocity that moved the point)."""
+    out[None] = ti.Vector([0.0, 0.0, 0.0])
     for p in now:
         f = now[p].F @ before[p].F.inverse()
         f -= ti.Matrix.identity(float, f.n)
         ti.atomic_max(out[None][0], ti.abs(now[p].T - before[p].T))
         ti.atomic_max(out[None][1], ti.sqrt((f * f).sum()))
+        dx = ti.max((now[p].x - before[p].x).norm(), now[p].v.norm() * dt)
+        ti.atomic_max(out[None][2], dx)
 
 
 class AdaptiveStepper:
@@ -104,7 +117,7 @@ class AdaptiveStepper:
         self.before = struct_type(POINT_MEMBERS, st.cfg.dim).field(
             shape=st.n_points, layout=ti.Layout.SOA
         )
-        self.changes = ti.Vector.field(2, float, ())
+        self.changes = ti.Vector.field(3, float, ())
 
     def set_step(self, dt: float) -> None:
         """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
@@ -131,11 +144,18 @@ class AdaptiveStepper:
             except NewtonError as e:
                 self._redo(before, dt, SHRINK**0.5 * dt, str(e))
                 continue
-            step_changes(st.points, self.before, self.changes)
-            dT, de = (float(x) for x in self.changes[None])
-            ratio = max(dT / self.controls.temperature_K, de / self.controls.strain)
+            step_changes(st.points, self.before, self.changes, dt)
+            dT, de, dx = (float(x) for x in self.changes[None])
+            ratio = max(
+                dT / self.controls.temperature_K,
+                de / self.controls.strain,
+                dx / (self.controls.cells * st.cfg.h),
+            )
             if ratio > REDO and dt > self.controls.dt_min:
-                why = f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g})"
+                why = (
+                    f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g}, "
+                    f"motion {dx / st.cfg.h:.3g} cells)"
+                )
                 self._redo(before, dt, next_step(dt, ratio, self.controls), why)
                 continue
             self.last_dt = dt

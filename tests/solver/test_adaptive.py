@@ -27,7 +27,7 @@ from taichi_sls.solver.time_step import heat_step_max
 from taichi_sls.studies import verification as ver
 
 ADAPTIVE = ["time.integrator=implicit", "time.adaptive=true"]
-CONTROLS = StepControls(dt_min=1e-9, dt_max=1e-3, temperature_K=5.0, strain=0.02)
+CONTROLS = StepControls(dt_min=1e-9, dt_max=1e-3, temperature_K=5.0, strain=0.02, cells=0.25)
 
 
 def test_next_step_follows_the_controls():
@@ -58,10 +58,12 @@ def test_step_changes_measure_temperature_and_strain():
     T[11] -= 2.5
     sim.state.points.F.from_numpy(F)
     sim.state.points.T.from_numpy(T)
-    step_changes(sim.state.points, sim.adaptive.before, sim.adaptive.changes)
-    dT, de = sim.adaptive.changes[None]
+    sim.state.points.v.fill(0.0)
+    step_changes(sim.state.points, sim.adaptive.before, sim.adaptive.changes, 1e-6)
+    dT, de, dx = sim.adaptive.changes[None]
     assert dT == pytest.approx(2.5)
     assert de == pytest.approx(np.linalg.norm(e), rel=1e-10)
+    assert dx == 0.0
 
 
 def test_laser_switch_times():
