@@ -1,11 +1,12 @@
 """Run time against error: ``taichi-sls bench cost [--quick] [--out renders]``.
 
 For the paper's 25 W case run to solidification (contact line at 1 ms and at the end, peak
-temperature) and for two verification cases in the Stokes regime (Hopper's coalescence at
-R0/h = 10, the viscous decay of a disc mode at R/h = 20), each setting -- the time step, the
-inertia scale ``solver.mass_scale``, the grid -- is run, timed (stepping only, after
-compilation) and compared with a reference: for the paper case a converged run (a quarter of
-the paper's step, physical inertia), for the verification cases the exact solution. Writes
+temperature; explicit over the step, the inertia scale and the grid, and the implicit
+integrator: adaptive, and hybrid) and for two verification cases in the Stokes regime
+(Hopper's coalescence at R0/h = 10, the viscous decay of a disc mode at R/h = 20), each
+setting is run, timed (stepping only, after compilation) and compared with a reference: for the
+paper case a converged run (a quarter of the paper's step, physical inertia), for the
+verification cases the exact solution. Writes
 ``cost_error.csv`` and ``cost_error.png`` (error against wall time) and prints the table.
 A paper run already complete under OUT/cost_runs/ is read, not run again (delete it to rerun).
 
@@ -28,6 +29,8 @@ from pathlib import Path
 from ..config import load_case
 from ..config.loading import add_set_argument
 
+IMPLICIT = ["time.integrator=implicit", "time.heat_integrator=implicit"]
+HYBRID = "time.integrator=hybrid"
 PAPER = [
     ("reference: dt 1.25e-8 s, s = 1", ["time.dt_s=1.25e-8"]),
     ("dt 2.5e-8 s, s = 1", ["time.dt_s=2.5e-8"]),
@@ -43,8 +46,31 @@ PAPER = [
         )
         for s in (1, 16, 256)
     ],
+    # the implicit integrator (docs/implicit.md): adaptive steps with backward-Euler heat, and
+    # explicit steps through the melting collapse handing over to them
+    *[
+        (
+            f"implicit, adaptive, strain {e:g}",
+            [*IMPLICIT, "time.adaptive=true", f"time.max_strain_increment={e}"],
+        )
+        for e in (0.02, 0.005)
+    ],
+    *[
+        (
+            f"hybrid: explicit dt {dt:g} s",
+            ["time.integrator=hybrid", *IMPLICIT[1:], f"time.dt_s={dt}"],
+        )
+        for dt in (5e-8, 1.25e-8)
+    ],
 ]
-QUICK = {"reference: dt 1.25e-8 s, s = 1", "paper: dt 5e-8 s, s = 1", "auto dt, s = 16"}
+QUICK = {
+    "reference: dt 1.25e-8 s, s = 1",
+    "paper: dt 5e-8 s, s = 1",
+    "auto dt, s = 16",
+    "implicit, adaptive, strain 0.02",
+    "hybrid: explicit dt 5e-08 s",
+    "hybrid: explicit dt 1.25e-08 s",
+}
 SCALES = (1, 4, 16, 64, 256)
 COLUMNS = [
     "scenario",
