@@ -28,11 +28,12 @@ COLOURS = 4
 LOOP_ITERATIONS = 8192
 
 
-def block_of(x: np.ndarray, h: float, off: int, n_bx: int) -> np.ndarray:
-    """Block index of points at positions x (m): cells counted from the array's origin."""
+def block_of(x: np.ndarray, h: float, off: int, n_bx: int, n_by: int) -> np.ndarray:
+    """Block index of points at positions x (m): cells counted from the array's origin; a point
+    beyond the grid counts in the edge block (the guard names it at the next check)."""
     cell = np.floor(x / h).astype(np.int64) + off
-    b = np.clip(cell // SIDE, 0, None)
-    return (b[:, 1] * n_bx + np.minimum(b[:, 0], n_bx - 1)).astype(np.int64)
+    b = np.clip(cell // SIDE, 0, [n_bx - 1, n_by - 1])
+    return (b[:, 1] * n_bx + b[:, 0]).astype(np.int64)
 
 
 @ti.data_oriented
@@ -75,11 +76,11 @@ class BlockPlan:
 
     def order(self, x: np.ndarray) -> np.ndarray:
         """The permutation that sorts points at x by block (stable: cell order kept within)."""
-        return np.argsort(block_of(x, self.h, self.off, self.n_bx), kind="stable")
+        return np.argsort(block_of(x, self.h, self.off, self.n_bx, self.n_by), kind="stable")
 
     def set_ranges(self, x_sorted: np.ndarray) -> None:
         """Each block's range of the sorted points."""
-        b = block_of(x_sorted, self.h, self.off, self.n_bx)
+        b = block_of(x_sorted, self.h, self.off, self.n_bx, self.n_by)
         count = np.bincount(b, minlength=self.n_blocks).astype(np.int32)
         start = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.int32)
         self.start.from_numpy(start)

@@ -5,7 +5,8 @@ configuration compiles it, 10-20 s, later calls load it) and compared with its r
 
 - verification cases against their exact solutions (Hopper's coalescence from his outline at
   R0/h = 20, the viscous decay of a disc mode and the Laplace pressure at R/h = 10), explicit and
-  implicit at steps 10x and 100x the explicit capillary limit;
+  implicit at steps 10x to 1000x the explicit capillary limit; the vibrating bar (16 cells, its
+  inertia the whole physics) at 1x and 10x the explicit elastic limit;
 - a second of viscous sintering of a PA12 pair (cases/verification/hopper_pa12.toml, out of the
   explicit integrator's reach: 3e8 steps) at R0/h = 10 and 20;
 - the paper's 25 W case to 1 ms (and, ``--refrozen``, until it has refrozen): explicit, implicit
@@ -35,10 +36,10 @@ IMPLICIT = {"integrator": "implicit"}
 COLUMNS = ["row", "integrator", "dt_s", "steps", "wall_s", "measure", "value", "error"]
 
 
-def _capillary_multiple(name: str, res: float, k: float) -> dict:
-    """The implicit time table at k times the explicit capillary limit of case ``name``."""
-    limit = time_step_limits(ver.load(name, res).case)["surface_tension"]
-    return {**IMPLICIT, "dt_s": k * limit}
+def _limit_multiple(name: str, res: float, k: float, limit: str) -> dict:
+    """The implicit time table at k times the explicit ``limit`` (surface_tension, elastic) of
+    case ``name``."""
+    return {**IMPLICIT, "dt_s": k * time_step_limits(ver.load(name, res).case)[limit]}
 
 
 def verification_rows(quick: bool) -> list[dict]:
@@ -51,22 +52,28 @@ def verification_rows(quick: bool) -> list[dict]:
         ("viscous_decay", 10, 100.0),
         ("laplace", 10, None),
         ("laplace", 10, 10.0),
+        ("laplace", 10, 100.0),
+        ("laplace", 10, 1000.0),
         ("hopper_pa12", 10, "case"),
         ("hopper_pa12", 20, "case"),
+        ("bar", 16, None),
+        ("bar", 16, 1.0),
+        ("bar", 16, 10.0),
     ]
     if quick:
         rows = [r for r in rows if r[0] != "hopper_shape" or r[2] == 100.0]
     out = []
     for name, res, k in rows:
         sets = None
+        limit = "elastic" if name == "bar" else "surface_tension"
         if isinstance(k, float):
-            sets = {"time": _capillary_multiple(name, res, k)}
+            sets = {"time": _limit_multiple(name, res, k, limit)}
         t0 = time.perf_counter()
         r = ver.run(ver.load(name, res, sets))
         wall = time.perf_counter() - t0
         integrator = "explicit" if k is None else "implicit"
         label = f"{name} R/h = {res:g}" + (
-            f", {k:g}x capillary limit" if isinstance(k, float) else ""
+            f", {k:g}x {limit.replace('_', ' ')} limit" if isinstance(k, float) else ""
         )
         for measure, err in r.errors.items():
             out.append(

@@ -101,3 +101,13 @@ def test_a_run_resumed_after_a_sort_continues_bitwise(tmp_path):
     assert [
         again.monitors(guard=False)[k] for k in ("contact_line_um", "neck_span_um")
     ] == want_neck
+
+
+def test_a_point_beyond_the_grid_sorts_into_the_edge_block():
+    """A point thrown above the grid (or left of it) counts in the edge block, so that sorting
+    never fails; the guard names the point at the next check."""
+    from taichi_sls.solver.blocks import SIDE, block_of
+
+    h, off, n_bx, n_by = 4e-6, 2, 3, 4
+    x = np.array([[1.0, 1.0], [-1.0, -1.0], [0.5 * SIDE * h, 0.5 * SIDE * h]])
+    assert block_of(x, h, off, n_bx, n_by).tolist() == [n_bx * n_by - 1, 0, 0]
