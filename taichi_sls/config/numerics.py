@@ -121,12 +121,13 @@ class Time(Model):
     direct_max_unknowns: int = Field(
         200_000, ge=1, description='implicit, linear_solver = "auto": the largest direct solve'
     )
-    heat_integrator: Literal["explicit", "implicit"] = Field(
-        "explicit",
+    heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
+        "auto",
         description="implicit integrator: the heat in explicit substeps of at most "
         "heat_step_fraction of its stability limit (explicit), or in one backward-Euler step "
         "per step (implicit: conduction at the new temperature, the capacity and conductivity "
-        "of the step's start; unconditionally stable, first order; solver/implicit_heat.py)",
+        "of the step's start; unconditionally stable, first order; solver/implicit_heat.py); "
+        "auto: implicit where the step adapts (adaptive, hybrid), else explicit",
     )
     adaptive: bool = Field(
         False,

@@ -224,6 +224,16 @@ class Case(Model):
         is nothing to step)."""
         return self.time.integrator != "explicit" and self.physics.mechanics
 
+    def implicit_heat(self) -> bool:
+        """Whether the implicit step takes its heat by backward Euler (``time.heat_integrator``;
+        "auto": where the step adapts)."""
+        t = self.time
+        if not self.implicit_mechanics() or not self.physics.thermal:
+            return False
+        if t.heat_integrator == "auto":
+            return t.adaptive or t.integrator == "hybrid"
+        return t.heat_integrator == "implicit"
+
     def lasers_off_s(self) -> float:
         """The time after which no laser heats (s): switched off, or scanned past x_end_um."""
         ends = [0.0]

@@ -224,7 +224,7 @@ def step_config(
         if thermal
         else 0.0,
         subgrid_rate=case.thermal.subgrid_filter / thermal_limit if thermal else 0.0,
-        heat_implicit=implicit and thermal and case.time.heat_integrator == "implicit",
+        heat_implicit=case.implicit_heat(),
         hysteresis=thermal
         and any(m.crystallization_range_C is not None for m in case.materials.values()),
         surface_method=method,

@@ -78,7 +78,7 @@ def resolve_heat_substeps(case: Case, dt: float) -> int:
     longest = heat_step_max(case)
     if math.isinf(longest):
         return 0
-    if case.time.heat_integrator == "implicit":  # one backward-Euler step
+    if case.implicit_heat():  # one backward-Euler step
         return 1
     return max(1, math.ceil(dt / longest - 1e-9))
 

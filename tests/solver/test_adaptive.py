@@ -52,6 +52,7 @@ def test_step_changes_measure_temperature_and_strain():
     e = 0.01 * rng.normal(size=(2, 2))
     F = np.repeat(F0[None], n, axis=0)
     T = np.full(n, 400.0)
+    copy_points(sim.state.points, sim.adaptive.before)
     sim.adaptive.before.F.from_numpy(F)
     sim.adaptive.before.T.from_numpy(T)
     F[7] = (np.eye(2) + e) @ F0

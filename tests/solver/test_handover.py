@@ -8,7 +8,7 @@ import pytest
 from taichi_sls.config import CaseError, load_case
 from taichi_sls.solver.simulation import Simulation
 
-HYBRID = ["time.integrator=hybrid", "time.heat_integrator=implicit"]
+HYBRID = ["time.integrator=hybrid"]
 
 
 def test_the_explicit_phase_is_the_explicit_integrator_bit_for_bit():
