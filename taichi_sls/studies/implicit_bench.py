@@ -5,8 +5,9 @@ configuration compiles it, 10-20 s, later calls load it) and compared with its r
 
 - verification cases against their exact solutions (Hopper's coalescence from his outline at
   R0/h = 20, the viscous decay of a disc mode and the Laplace pressure at R/h = 10), explicit and
-  implicit at steps 10x to 1000x the explicit capillary limit; the vibrating bar (16 cells, its
-  inertia the whole physics) at 1x and 10x the explicit elastic limit;
+  implicit at steps 10x and 100x the explicit capillary limit (the Laplace run ends within 100
+  such steps); the vibrating bar (16 cells, its inertia the whole physics) at 1x and 10x the
+  explicit elastic limit;
 - a second of viscous sintering of a PA12 pair (cases/verification/hopper_pa12.toml, out of the
   explicit integrator's reach: 3e8 steps) at R0/h = 10 and 20;
 - the paper's 25 W case to 1 ms (and, ``--refrozen``, until it has refrozen): explicit, implicit
@@ -52,8 +53,6 @@ def verification_rows(quick: bool) -> list[dict]:
         ("viscous_decay", 10, 100.0),
         ("laplace", 10, None),
         ("laplace", 10, 10.0),
-        ("laplace", 10, 100.0),
-        ("laplace", 10, 1000.0),
         ("hopper_pa12", 10, "case"),
         ("hopper_pa12", 20, "case"),
         ("bar", 16, None),
