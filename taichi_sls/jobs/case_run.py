@@ -178,6 +178,7 @@ def run_case(
         solidify=solidify,
         T_c=min(m.solid_below_C() for m in case.materials.values()),
         T_wall=min(walls) if walls else math.nan,
+        adaptive=sim.adaptive is not None,
     )
     step_wall = 0.0
     steps0 = sim.steps
@@ -198,7 +199,8 @@ def run_case(
                 else:
                     sim.advance(min(2000, schedule[k - 1] - sim.steps))
                 step_wall += time.perf_counter() - t0
-                bar.update(sim.t, (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0)
+                pace = (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0
+                bar.update(sim.t, pace, sim.step_dt)
             last = frame(k)
             bar.note(last)
             if checkpoint_every and k % checkpoint_every == 0:

@@ -24,8 +24,12 @@ class Progress:
         solidify: bool = False,
         T_c: float = math.nan,
         T_wall: float = math.nan,
+        adaptive: bool = False,
     ) -> None:
         self._bar = None
+        # an adaptive step grows by orders of magnitude: the pace so far says nothing of the
+        # time left, so the bar shows the step instead
+        self.adaptive = adaptive
         self.horizon = horizon_s
         self.solidify, self.T_c, self.T_wall = solidify, T_c, T_wall
         self._molten: float | None = None
@@ -44,15 +48,17 @@ class Progress:
                 bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} us [{elapsed}{postfix}]",
             )
 
-    def update(self, t: float, steps_per_s: float) -> None:
+    def update(self, t: float, steps_per_s: float, dt: float = math.nan) -> None:
         if self._bar is None:
             return
         self._bar.n = round(min(t, self.horizon) * 1e6, 3)
         text = f"{steps_per_s:,.0f} steps/s"
         if self._molten is not None:
             text += f", molten {self._molten:.0%}"
-        left = self.time_left(t)
-        if math.isfinite(left):
+        left = math.nan if self.adaptive else self.time_left(t)
+        if self.adaptive:
+            text += f", dt {dt:.2g} s"
+        elif math.isfinite(left):
             text += f", ~{left:.0f} s left"
         self._bar.set_postfix_str(text, refresh=False)
         self._bar.refresh()

@@ -188,3 +188,19 @@ def test_max_time_is_marked_not_complete(tmp_path):
     s = run_case(case, tmp_path / "short", progress=False)
     assert s["status"] == "max_time" and s["outcome"]["fused"] is None
     assert any("max_s" in w for w in s["warnings"])
+
+
+def test_the_progress_bar_of_an_adaptive_run_shows_its_step_not_a_guess(capsys):
+    """The pace of an adaptive run's first steps (a thousandth of its later ones) says nothing
+    of the time left: the bar shows the step instead; a fixed-step run estimates the time left
+    from its pace."""
+    from taichi_sls.jobs.progress import Progress
+
+    for adaptive in (True, False):
+        bar = Progress(1.0, 0.0, adaptive=adaptive)
+        bar.note({"molten_fraction": 0.5, "t_s": 1e-3, "T_max_C": 300.0})
+        bar.update(1e-3, 40.0, 2.5e-5)
+        bar.close()
+        err = capsys.readouterr().err
+        assert ("dt 2.5e-05 s" in err) == adaptive
+        assert ("s left" in err) != adaptive
