@@ -29,22 +29,22 @@ def test_hopper_at_a_constant_temperature_is_hoppers_clock():
 def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path):
     """The bundled case for its second (the implicit integrator, adaptive steps, backward-Euler
     heat): the pulse melts the pair, it cools to the 170 C bed and stays molten (it crystallises
-    only below 150 C), and its neck follows Hopper's at the recorded temperature: within the
-    issue's 3 % at 1 s (measured -0.5 to -1.2 % over four sets of step controls,
-    docs/implicit.md), within 6 % from 0.1 s on (measured up to +5.1 %: the clock runs at the
-    pair's mean temperature, and while the pair cools its neck is hotter than the mean); the
-    neck has grown by 2.5 times."""
+    only below 150 C), and its neck follows Hopper's at the recorded
+    temperature within the issue's 3 % at 1 s (measured -0.5 to -1.2 % over four sets of step
+    controls, docs/implicit.md), within 6 % from 0.1 s on (measured up to +5.1 %: the clock runs
+    at the pair's mean temperature, and while the pair cools its neck is hotter than the mean);
+    molten and at 170 C throughout the hold; the neck has grown by 2.5 times."""
     case = load_case("sinter_hold", ["output.png=false", "output.gif=false"])
     summary = run_case(case, tmp_path, progress=False)
     assert summary["status"] == "complete"
     rows = compare(tmp_path)
     last = rows[-1]
     assert last["t_s"] == pytest.approx(1.0)
-    assert last["molten_fraction"] == 1.0
-    assert last["T_mean_C"] == pytest.approx(170.0, abs=0.01)
     late = [r for r in rows if r["t_s"] >= 0.1 * (1 - 1e-9)]
     assert len(late) >= 5
     print("neck against Hopper:", [(r["t_s"], r["difference"]) for r in late])
+    assert all(r["molten_fraction"] == 1.0 for r in late)
+    assert all(abs(r["T_mean_C"] - 170.0) < 0.1 for r in late)
     assert abs(last["difference"]) < 0.03
     assert all(abs(r["difference"]) < 0.06 for r in late)
     assert last["neck_um"] > 2.5 * rows[0]["neck_um"]
