@@ -51,7 +51,7 @@ from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
 from .linear_solve import LinearSolver, linear_solver
-from .loops import check_block, grow_box, point_loop
+from .loops import check_block, grow_box, in_order, point_loop
 from .step import (
     advance_clock,
     clear_grid,
@@ -93,15 +93,9 @@ def _clear_matrix(K: ti.template(), I, dim: ti.template()):
             K[I, o, a, b] = 0.0
 
 
-@ti.kernel
-def begin(st: ti.template()):
+def begin(st: State) -> None:
     """Everything of the step before the Newton loop (module docstring)."""
-    if ti.static(st.cfg.parallel):
-        _begin(st)
-    else:
-        ti.loop_config(serialize=True)
-        for _ in range(1):
-            _begin(st)
+    in_order(st, _begin)
 
 
 @ti.func

@@ -35,7 +35,7 @@ from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
 from ..physics.thermal import fixed_temperature, point_conductivity
 from .fields import State
 from .linear_solve import LinearSolver, linear_solver
-from .loops import point_loop
+from .loops import in_order, point_loop
 from .step import (
     clear_grid,
     g2p_point_heat,
@@ -51,18 +51,6 @@ RATE_STAGES = (clear_grid, p2g, grid_temperature_stage, heat_flux)
 SUBSTEP_STAGES = (*RATE_STAGES, grid_update)
 # the relative residual of the linear solve: its error moves heat between nodes, never creates it
 HEAT_RTOL = 1e-10
-
-
-@ti.kernel
-def in_order(st: ti.template(), body: ti.template()):
-    """``body(st)`` as one kernel: its loops parallel, or in the serial layout serialized, so
-    that a run repeats bit for bit."""
-    if ti.static(st.cfg.parallel):
-        body(st)
-    else:
-        ti.loop_config(serialize=True)
-        for _ in range(1):
-            body(st)
 
 
 @ti.func

@@ -134,3 +134,15 @@ def widen(box, lo, hi):
     return ti.Vector(
         [ti.min(box[0], lo[0]), ti.min(box[1], lo[1]), ti.max(box[2], hi[0]), ti.max(box[3], hi[1])]
     )
+
+
+@ti.kernel
+def in_order(st: ti.template(), body: ti.template()):
+    """``body(st)`` as one kernel: its loops parallel, or in the serial layout serialized, so
+    that a run repeats bit for bit."""
+    if ti.static(st.cfg.parallel):
+        body(st)
+    else:
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            body(st)
