@@ -2,10 +2,14 @@
 explicit phase is the explicit integrator bit for bit, the hand-over waits for the laser and the
 motion, and the answer is the explicit run's at a fraction of its steps."""
 
+import math
+
 import numpy as np
 import pytest
 
 from taichi_sls.config import CaseError, load_case
+from taichi_sls.jobs.case_run import run_case
+from taichi_sls.jobs.unheated import unheated_neck_um
 from taichi_sls.solver.simulation import Simulation
 
 HYBRID = ["time.integrator=hybrid"]
@@ -48,3 +52,17 @@ def test_the_hybrid_neck_is_the_explicit_one_at_a_fraction_of_the_steps():
 def test_hybrid_takes_the_implicit_restrictions():
     with pytest.raises(CaseError, match="surface_tension.method"):
         load_case("power25W_coarse", ["time.integrator=hybrid", "surface_tension.method=csf"])
+
+
+def test_a_hybrid_run_to_refreezing_gives_its_verdict(tmp_path):
+    """The coarse 25 W pair to refreezing as the main job: complete, with the unheated
+    baseline (itself run hybrid, landing on fusion.baseline_s) within 1 % of the explicit
+    one, so that the verdict is given."""
+    sets = [*HYBRID, "time.stop=solidified", "output.png=false", "output.gif=false"]
+    summary = run_case(load_case("power25W_coarse", sets), tmp_path, progress=False)
+    outcome = summary["outcome"]
+    assert summary["status"] == "complete" and outcome["fused"] is not None
+    explicit = unheated_neck_um(load_case("power25W_coarse", ["time.stop=solidified"]))
+    print("unheated neck, hybrid and explicit:", outcome["neck_unheated_um"], explicit)
+    assert math.isfinite(explicit)
+    assert outcome["neck_unheated_um"] == pytest.approx(explicit, rel=0.01)
