@@ -52,15 +52,17 @@ def transfer_label(case: Case) -> str:
 
 
 def samples(sim, n_out: int, end_s: float, read: Callable[[], float]) -> tuple:
-    """Advance to ``end_s`` in ``n_out`` equal chunks of whole steps; read after each."""
+    """Advance to ``end_s`` in ``n_out`` equal chunks of whole steps (of the first step, with
+    an adaptive one); read after each."""
     per = max(1, int(round(end_s / n_out / sim.dt)))
     ts, vals = [sim.t], [read()]
     for _ in range(n_out):
-        sim.advance(per)
+        sim.advance_to(sim.t + per * sim.dt)
         ts.append(sim.t)
         vals.append(read())
     return np.array(ts), np.array(vals)
 
 
-def run_to(sim, end_s: float) -> None:
-    sim.advance(int(round(end_s / sim.dt)))
+def run_to(sim, duration_s: float) -> None:
+    """Advance by ``duration_s`` in whole steps (of the first step, with an adaptive one)."""
+    sim.advance_to(sim.t + int(round(duration_s / sim.dt)) * sim.dt)

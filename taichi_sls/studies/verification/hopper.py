@@ -96,7 +96,7 @@ def hopper_neck_history(vc: VerificationCase, tau_end: float, d_tau: float = 0.0
     t_align = 0.0 if v.hopper_tau0 > 0 else None
     tau_align = v.hopper_tau0 if v.hopper_tau0 > 0 else ref.hopper_tau_at_neck(v.hopper_align)
     while True:
-        sim.advance(per)
+        sim.advance_to(sim.t + per * sim.dt)  # whole steps; an adaptive one lands there
         sample()
         if t_align is None and rn[-1] >= v.hopper_align:
             a, b = rn[-2], rn[-1]
