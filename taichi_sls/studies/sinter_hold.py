@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from ..config import Material, load_case
+from ..config.loading import add_set_argument
+from ..io.atomic import atomic_path
 from ..io.series import read_series
 from ..jobs.case_run import complete_summary, run_case
 from . import references as ref
@@ -110,7 +112,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap = sub.add_parser("hold", help="a laser-melted pair sintering for a second, against Hopper")
     ap.add_argument("--out", default="renders", help="folder for sinter_hold.csv and .png")
     ap.add_argument("--runs", default="out/bench_hold", help="folder of the run")
-    ap.add_argument("--set", action="append", default=[], help="KEY=VALUE override of the case")
+    add_set_argument(ap, "override of the case")
     ap.set_defaults(func=main)
 
 
@@ -122,7 +124,7 @@ def main(args: argparse.Namespace) -> int:
     if summary is None:
         summary = run_case(load_case(CASE, args.set), run_dir)
     rows = compare(run_dir)
-    with (out / "sinter_hold.csv").open("w", newline="") as f:
+    with atomic_path(out / "sinter_hold.csv") as path, path.open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
