@@ -224,15 +224,20 @@ class Case(Model):
         is nothing to step)."""
         return self.time.integrator != "explicit" and self.physics.mechanics
 
+    def step_adapts(self) -> bool:
+        """Whether the implicit step's size is chosen by the physics (``time.adaptive``, or the
+        hybrid integrator's implicit phase)."""
+        t = self.time
+        return self.implicit_mechanics() and (t.adaptive or t.integrator == "hybrid")
+
     def implicit_heat(self) -> bool:
         """Whether the implicit step takes its heat by backward Euler (``time.heat_integrator``;
         "auto": where the step adapts)."""
-        t = self.time
         if not self.implicit_mechanics() or not self.physics.thermal:
             return False
-        if t.heat_integrator == "auto":
-            return t.adaptive or t.integrator == "hybrid"
-        return t.heat_integrator == "implicit"
+        if self.time.heat_integrator == "auto":
+            return self.step_adapts()
+        return self.time.heat_integrator == "implicit"
 
     def lasers_off_s(self) -> float:
         """The time after which no laser heats (s): switched off, or scanned past x_end_um."""

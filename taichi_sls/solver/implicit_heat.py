@@ -22,7 +22,6 @@ capacity varies.
 """
 
 import itertools
-import math
 
 import numpy as np
 import scipy.sparse as sp
@@ -45,6 +44,7 @@ from .step import (
     p2g,
     point_stencil,
 )
+from .time_step import substeps_within
 
 # the explicit step's heat stages up to the nodes' heat rate
 RATE_STAGES = (clear_grid, p2g, grid_temperature_stage, heat_flux)
@@ -129,7 +129,7 @@ class StepHeat:
         if self.substeps == 0:
             return
         if not self.st.cfg.heat_implicit:
-            self.substeps = max(1, math.ceil(dt / longest - 1e-9))
+            self.substeps = substeps_within(dt, longest)
         self.st.scalars.dt_heat[None] = dt / self.substeps
 
     def advance(self) -> None:

@@ -116,7 +116,7 @@ class Simulation(NeckMeasures):
         if cfg.implicit:
             self.state.scalars.dt_heat[None] = dt_heat
             self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
-            if case.time.adaptive or hybrid:  # hybrid: from implicit_step_factor x its dt
+            if case.step_adapts():  # hybrid: from implicit_step_factor x its dt
                 dt0 = self.dt * (case.time.implicit_step_factor if hybrid else 1.0)
                 longest = heat_step_max(case)
                 self.adaptive = AdaptiveStepper(case, self.state, self.implicit, dt0, longest)
@@ -183,10 +183,12 @@ class Simulation(NeckMeasures):
         if not self.explicit_now:
             self.steps += self.adaptive.advance_to(t, self._after_step)
 
-    def kinetic_ratio(self) -> float:
-        """The kinetic energy (times the inertia scale) over the surface energy."""
-        ke = point_monitors(self.state)[0]["kinetic_energy_J_per_m"]
-        return self.case.solver.mass_scale * ke / self.surface_energy()
+    def kinetic_ratio(self, kinetic_energy: float | None = None) -> float:
+        """The kinetic energy (times the inertia scale; default: the points' now) over the
+        surface energy."""
+        if kinetic_energy is None:
+            kinetic_energy = point_monitors(self.state)[0]["kinetic_energy_J_per_m"]
+        return self.case.solver.mass_scale * kinetic_energy / self.surface_energy()
 
     def _after_step(self) -> None:
         if self.blocks is not None and self.blocks.needs_sort[None]:
@@ -254,9 +256,7 @@ class Simulation(NeckMeasures):
         out["heat_out_J_per_m"] = float(st.scalars.heat_out[None])
         # inertia against the surface energy: small when the flow is quasi-static (the rule of
         # solver.mass_scale and of the settled state of time.stop = "solidified")
-        out["kinetic_ratio"] = (
-            self.case.solver.mass_scale * out["kinetic_energy_J_per_m"] / self.surface_energy()
-        )
+        out["kinetic_ratio"] = self.kinetic_ratio(out["kinetic_energy_J_per_m"])
         cl, span = self.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6

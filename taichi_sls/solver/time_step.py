@@ -72,6 +72,11 @@ def heat_step_max(case: Case) -> float:
     return case.time.heat_step_fraction * time_step_limits(case).get("thermal", math.inf)
 
 
+def substeps_within(dt: float, longest: float) -> int:
+    """The fewest substeps of dt that are each at most ``longest``."""
+    return max(1, math.ceil(dt / longest - 1e-9))
+
+
 def resolve_heat_substeps(case: Case, dt: float) -> int:
     """Heat substeps per implicit step: the fewest whose step is at most :func:`heat_step_max`
     (0 without heat)."""
@@ -80,7 +85,7 @@ def resolve_heat_substeps(case: Case, dt: float) -> int:
         return 0
     if case.implicit_heat():  # one backward-Euler step
         return 1
-    return max(1, math.ceil(dt / longest - 1e-9))
+    return substeps_within(dt, longest)
 
 
 def _every(
