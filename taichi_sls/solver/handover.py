@@ -24,7 +24,12 @@ from .adaptive import AdaptiveStepper
 from .fields import State
 from .scene import Scene
 from .step_config import step_config
-from .time_step import resolve_curvature_every, resolve_heat_every, time_step_limits
+from .time_step import (
+    resolve_curvature_every,
+    resolve_heat_every,
+    substeps_within,
+    time_step_limits,
+)
 
 CHECK_S = 1e-5  # simulated time between checks of the hand-over rule (s)
 
@@ -61,12 +66,11 @@ class Handover:
     ) -> None:
         self.view = view
         self.adaptive = adaptive
-        self.dt = dt
         self.lasers_off_s = case.lasers_off_s()
         self.fraction = case.time.handover_kinetic_fraction
         self.kinetic_ratio = kinetic_ratio
-        every = view.cfg.heat_every
-        self.check_every = every * max(1, math.ceil(CHECK_S / (dt * every) - 1e-9))
+        every = view.cfg.heat_every  # whole heat steps of the explicit phase, ~CHECK_S apart
+        self.check_every = every * substeps_within(CHECK_S, dt * every)
         self.explicit = True
         self.at_s = math.nan  # when the implicit step took over
 
