@@ -138,8 +138,11 @@ class Time(Model):
     )
     dt_min_s: AutoPositive = Field(
         "auto",
-        description='adaptive: the smallest step (s); "auto": the first step / 1000. A step '
-        "that must go below it ends the run with an error",
+        description='adaptive: the smallest step (s); "auto": the first step / 1000, and for '
+        "the hybrid its explicit step (below it an explicit step is cheaper, and a jump no "
+        "step resolves, such as two melt surfaces snapping into contact, would hold the "
+        "implicit step far below it). A step at it is taken whatever its changes; one whose "
+        "Newton fails there ends the run with an error",
     )
     dt_max_s: AutoPositive = Field(
         "auto",

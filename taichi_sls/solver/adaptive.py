@@ -47,9 +47,11 @@ class StepControls:
     cells: float
 
     @classmethod
-    def from_case(cls, case: Case, dt0: float) -> "StepControls":
+    def from_case(cls, case: Case, dt0: float, floor: float | None = None) -> "StepControls":
+        """``floor``: the smallest step under dt_min_s = "auto" (default dt0 / 1000)."""
         t = case.time
-        dt_min = dt0 / 1000.0 if t.dt_min_s == "auto" else float(t.dt_min_s)
+        auto = dt0 / 1000.0 if floor is None else floor
+        dt_min = auto if t.dt_min_s == "auto" else float(t.dt_min_s)
         dt_max = math.inf if t.dt_max_s == "auto" else float(t.dt_max_s)
         return cls(
             dt_min,
@@ -100,14 +102,21 @@ def step_changes(now: ti.template(), before: ti.template(), out: ti.template(), 
 
 class AdaptiveStepper:
     """Implicit steps of a size chosen by :class:`StepControls` (module docstring).
-    ``heat_step_max``: the longest heat substep (s), which sets the substeps of each step."""
+    ``heat_step_max``: the longest heat substep (s), which sets the substeps of each step;
+    ``floor``: the smallest step under dt_min_s = "auto" (the hybrid's explicit step)."""
 
     def __init__(
-        self, case: Case, st: State, implicit: ImplicitStepper, dt0: float, heat_step_max: float
+        self,
+        case: Case,
+        st: State,
+        implicit: ImplicitStepper,
+        dt0: float,
+        heat_step_max: float,
+        floor: float | None = None,
     ) -> None:
         self.st = st
         self.implicit = implicit
-        self.controls = StepControls.from_case(case, dt0)
+        self.controls = StepControls.from_case(case, dt0, floor)
         self.dt = min(self.controls.dt_max, max(self.controls.dt_min, dt0))  # the next to try
         self.heat_step_max = heat_step_max
         self.edges = laser_switch_times(case)

@@ -119,7 +119,10 @@ class Simulation(NeckMeasures):
             if case.step_adapts():  # hybrid: from implicit_step_factor x its dt
                 dt0 = self.dt * (case.time.implicit_step_factor if hybrid else 1.0)
                 longest = heat_step_max(case)
-                self.adaptive = AdaptiveStepper(case, self.state, self.implicit, dt0, longest)
+                floor = self.dt if hybrid else None
+                self.adaptive = AdaptiveStepper(
+                    case, self.state, self.implicit, dt0, longest, floor
+                )
         if hybrid:
             view = explicit_view(case, self.state, self.scene, self.dt)
             self.handover = Handover(case, view, self.adaptive, self.dt, self.kinetic_ratio)

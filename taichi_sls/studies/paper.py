@@ -65,7 +65,7 @@ def _row(name: str, s: dict) -> dict:
 def _figures(out: Path, rows: list[dict]) -> None:
     """Figs. 5 and 8 from the fine cases and nolaser (0 W), through the sweep's plots: their
     rows as OUT/results.csv, one id per case folder."""
-    from .sweep.plots import draw_all
+    from .sweep.draw import draw_all
     from .sweep.results import write_results
 
     fine = [

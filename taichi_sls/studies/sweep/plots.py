@@ -12,8 +12,8 @@
 Each row's laser power, spot radius and speed, and its initial contact line, come from the case's
 own outputs (``OUT/<id>/case.toml``, ``OUT/<id>/summary.json``); without them, from the row's
 columns (the base value of an unswept key is then unknown and the row is left out).
-:func:`draw_all` draws every figure the rows support into the output folder (the process map
-only for a complete power x speed grid). Rows with status
+``draw.draw_all`` draws every figure the rows support (the process map only for a complete
+power x speed grid). Rows with status
 ``complete`` are drawn as filled markers, ``failed`` ones (the guard stopped the run; values at
 that time) as open ones.
 """
@@ -247,23 +247,3 @@ def _save(fig: Figure, png: str | Path) -> Path:
     png.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(png, dpi=DPI)
     return png
-
-
-def draw_all(out_dir: str | Path) -> list[Path]:
-    """Draw every figure that OUT/results.csv supports into OUT/; return the PNG paths."""
-    out = Path(out_dir)
-    csv_path = out / "results.csv"
-    rows = load_rows(csv_path)
-    written = []
-    stationary = [r for r in rows if r["v_m_s"] == 0]
-    if len({r["P_W"] for r in stationary}) >= 2:
-        written.append(plot_power(csv_path, out / "fig5_power.png"))
-    if any(r["v_m_s"] not in (0, None) for r in rows) or len({r["r0_um"] for r in rows}) >= 2:
-        written.append(plot_radius_scan(csv_path, out / "fig8_radius_scan.png"))
-    for xkey, name in (("v_m_s", "process_map.png"), ("r0_um", "process_map_radius.png")):
-        sel = [r for r in rows if xkey == "v_m_s" or r["v_m_s"] == 0]
-        cells = {(r[xkey], r["P_W"]) for r in sel if None not in (r[xkey], r["P_W"])}
-        n_x, n_P = len({c[0] for c in cells}), len({c[1] for c in cells})
-        if n_x >= 2 and n_P >= 2 and len(cells) == n_x * n_P:  # a complete grid
-            written.append(plot_process_map(csv_path, out / name, xkey))
-    return written

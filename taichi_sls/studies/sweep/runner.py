@@ -40,11 +40,12 @@ overrides (``set`` included), so the id is stable across restarts and machines; 
 finished case, rewritten atomically as results arrive. Columns: ``id``, every swept key (named by
 the key; empty where a case leaves it at the base value), the collected quantities (from the
 summary's ``final`` monitors, else its fusion ``outcome``, e.g. ``fused`` or ``neck_final_um``,
-else its top level, e.g. ``steps``), ``status``, ``error`` and ``wall_s`` (wall time of the
-whole case, compilation included). Status: ``complete``, ``max_time`` (a run to solidification
-that gave up), ``failed`` (the solver's guard stopped the run; its message in ``error``),
-``interrupted`` or ``error`` (an exception, e.g. an override the loader refuses; the message in
-``error``). No case stops the sweep.
+else its top level, e.g. ``steps``; a dotted name is a path into the summary, e.g.
+``bed.fused_fraction`` or ``bed.relative_density.final``), ``status``, ``error`` and ``wall_s``
+(wall time of the whole case, compilation included). Status: ``complete``, ``max_time`` (a run
+to solidification that gave up), ``failed`` (the solver's guard stopped the run; its message in
+``error``), ``interrupted`` or ``error`` (an exception, e.g. an override the loader refuses; the
+message in ``error``). No case stops the sweep.
 
 Restart: run the same command again. Cases whose id already has a row with a final status
 (``complete``, ``max_time``, ``failed`` or ``error``: the solver is deterministic, so these would
@@ -86,7 +87,12 @@ def _collect(summary: dict[str, Any], names: list[str]) -> dict[str, Any]:
     for n in names:
         if n in ("status", "error", "id", "wall_s"):
             continue
-        v = final.get(n, outcome.get(n, summary.get(n)))
+        if "." in n:  # a path into the summary, e.g. bed.relative_density.final
+            v: Any = summary
+            for part in n.split("."):
+                v = v.get(part) if isinstance(v, dict) else None
+        else:
+            v = final.get(n, outcome.get(n, summary.get(n)))
         out[n] = v if isinstance(v, (int, float, str, bool)) or v is None else json.dumps(v)
     return out
 
@@ -253,7 +259,7 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     if args.plots or args.plot_only:
-        from .plots import draw_all
+        from .draw import draw_all
 
         if not (out / "results.csv").is_file():
             print(f"error: {out / 'results.csv'} does not exist", file=sys.stderr)
