@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .bed_plots import plot_bed_map
+from .bed_plots import FUSED, plot_bed_map
 from .plots import load_rows, plot_power, plot_process_map, plot_radius_scan
 
 
@@ -14,7 +14,7 @@ def draw_all(out_dir: str | Path) -> list[Path]:
     out = Path(out_dir)
     csv_path = out / "results.csv"
     rows = load_rows(csv_path)
-    if any(r.get("bed.fused_fraction") not in (None, "") for r in rows):  # a bed sweep
+    if any(r.get(FUSED) not in (None, "") for r in rows):  # a bed sweep
         return [plot_bed_map(csv_path, out / "bed_map.png")]
     written = []
     stationary = [r for r in rows if r["v_m_s"] == 0]
