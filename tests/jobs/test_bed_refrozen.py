@@ -83,7 +83,9 @@ def test_melted_contacts_grow_and_the_layer_densifies(refrozen):
     few per cent: the melt lives some 0.1 s on the 140 C plate, a tenth of the viscous time
     eta R / gamma. So the median grows, and none shrinks by more than the section's reading
     error at h = 4 um (a quarter cell of a 17 um neck is 6 %; 1 % allowed). A fused contact grew
-    by at least the rule's margin. The layer sinks and densifies."""
+    by at least the rule's margin. The layer densifies: its pores close under the same envelope.
+    (Its top does not measurably sink here: a 3 % neck growth brings two 20 um discs together by
+    about 0.1 um, a tenth of the quarter cell at which the top profile is read.)"""
     case, summary, rows = refrozen
     through = [r for r in rows if int(r["melted_through"])]
     assert through
@@ -95,4 +97,3 @@ def test_melted_contacts_grow_and_the_layer_densifies(refrozen):
             assert float(r["neck_final_um"]) >= margin * float(r["neck_initial_um"])
     d = summary["bed"]["relative_density"]
     assert d["final"] > d["initial"]
-    assert d["mean_top_final_um"] < d["mean_top_initial_um"]
