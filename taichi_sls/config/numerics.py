@@ -86,6 +86,15 @@ class Time(Model):
         description="hybrid: the kinetic energy (times solver.mass_scale), as a fraction of gamma "
         "times the bodies' perimeter, below which the implicit step takes over",
     )
+    handback_explicit_steps: float = Field(
+        20.0,
+        ge=1,
+        description="hybrid, after the hand-over: when the adaptive step would be shorter than "
+        "this many explicit steps (an implicit step there costs a Newton solve for what "
+        "explicit steps do far cheaper: contacts snapping shut in a bed), explicit steps take "
+        "over again until a stretch of them shows that a step this long meets the controls "
+        "(solver/handover.py)",
+    )
     implicit_step_factor: float = Field(
         50.0,
         gt=0,
@@ -164,8 +173,16 @@ class Time(Model):
     max_strain_increment: float = Field(
         0.02,
         gt=0,
-        description="adaptive: the largest strain increment of any point in one step: the "
-        "Frobenius norm of f - I, f = F^{n+1} (F^n)^-1 the step's deformation gradient",
+        description="adaptive: the largest strain increment of any point in one step (the "
+        "measure: strain_control)",
+    )
+    strain_control: Literal["total", "plastic"] = Field(
+        "total",
+        description="adaptive: total: the Frobenius norm of f - I, f = F^{n+1} (F^n)^-1 the "
+        "step's deformation gradient; plastic: the equivalent plastic (viscous) strain "
+        "increment, the only part of the strain whose path a step's size changes: an elastic "
+        "jump (two melt surfaces snapping into contact) reaches the same quasi-static state at "
+        "any step, and the total measure chased it down to the explicit step (docs/beds.md)",
     )
 
 

@@ -2,8 +2,10 @@
 
 Each step is taken with the current dt and then measured: the largest temperature change of any
 point, dT, the largest strain increment, de = |f - I| (Frobenius; f = F^{n+1} (F^n)^-1, the
-step's deformation gradient), and the farthest motion of a point, dx (or its velocity times
-dt, which the guard limits). Against the case's
+step's deformation gradient; or, with ``time.strain_control = "plastic"``, the largest increment
+of the equivalent plastic strain: the elastic part reaches its quasi-static state at any step),
+and the farthest motion of a point, dx (or its velocity times dt, which the guard limits).
+Against the case's
 controls, r = max(dT / dT_max, de / de_max, dx / (cells h)), and the next step follows as for a
 first-order method, whose error per step grows with dt: dt_next = SAFETY dt / r, at most GROWTH
 and at least SHRINK times the last, within [dt_min, dt_max]. So the step grows while nothing
@@ -45,6 +47,7 @@ class StepControls:
     temperature_K: float
     strain: float
     cells: float
+    plastic: bool = False  # the strain control reads the plastic increment, not the total
 
     @classmethod
     def from_case(cls, case: Case, dt0: float, floor: float | None = None) -> "StepControls":
@@ -59,6 +62,7 @@ class StepControls:
             t.max_temperature_change_K,
             t.max_strain_increment,
             t.max_motion_cells,
+            t.strain_control == "plastic",
         )
 
 
@@ -86,11 +90,11 @@ def copy_points(src: ti.template(), dst: ti.template()):
 
 @ti.kernel
 def step_changes(now: ti.template(), before: ti.template(), out: ti.template(), dt: float):
-    """out = (dT, de, dx): the largest temperature change (K), strain increment
-    |F F_before^-1 - I| (Frobenius) and motion (m) of any point over the step dt since
-    ``before``; the motion also as the point's own velocity times dt, which the guard limits
-    (with FLIP it is not the grid velocity that moved the point)."""
-    out[None] = ti.Vector([0.0, 0.0, 0.0])
+    """out = (dT, de, dx, dp): the largest temperature change (K), strain increment
+    |F F_before^-1 - I| (Frobenius), motion (m) and equivalent plastic strain increment of any
+    point over the step dt since ``before``; the motion also as the point's own velocity times
+    dt, which the guard limits (with FLIP it is not the grid velocity that moved the point)."""
+    out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0])
     for p in now:
         f = now[p].F @ before[p].F.inverse()
         f -= ti.Matrix.identity(float, f.n)
@@ -98,6 +102,8 @@ def step_changes(now: ti.template(), before: ti.template(), out: ti.template(), 
         ti.atomic_max(out[None][1], ti.sqrt((f * f).sum()))
         dx = ti.max((now[p].x - before[p].x).norm(), now[p].v.norm() * dt)
         ti.atomic_max(out[None][2], dx)
+        dp = now[p].equivalent_plastic_strain - before[p].equivalent_plastic_strain
+        ti.atomic_max(out[None][3], dp)
 
 
 class AdaptiveStepper:
@@ -121,12 +127,13 @@ class AdaptiveStepper:
         self.heat_step_max = heat_step_max
         self.edges = laser_switch_times(case)
         self.last_dt = self.dt  # the last step taken
+        self.handback_below = 0.0  # hybrid: no step shorter than this (solver/handover.py)
         self.refused = 0  # steps redone smaller, over the run
         # the points before the step, on the device (a host copy cost a fifth of a step)
         self.before = struct_type(POINT_MEMBERS, st.cfg.dim).field(
             shape=st.n_points, layout=ti.Layout.SOA
         )
-        self.changes = ti.Vector.field(3, float, ())
+        self.changes = ti.Vector.field(4, float, ())
 
     def set_step(self, dt: float) -> None:
         """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
@@ -138,10 +145,23 @@ class AdaptiveStepper:
         stop = min([t_end, *(e for e in self.edges if e > t * (1 + 1e-12))])
         return min(self.dt, stop - t)
 
-    def step(self, t_end: float = math.inf) -> None:
-        """One accepted step (redoing refused ones), at most up to ``t_end``."""
+    def changes_ratio(self, dt: float) -> float:
+        """The changes of the points since :attr:`before` (over dt), as a multiple of the
+        controls: the largest of dT / dT_max, de / de_max and dx / (cells h)."""
+        step_changes(self.st.points, self.before, self.changes, dt)
+        dT, de, dx, dp = (float(x) for x in self.changes[None])
+        c = self.controls
+        strain = dp if c.plastic else de
+        return max(dT / c.temperature_K, strain / c.strain, dx / (c.cells * self.st.cfg.h))
+
+    def step(self, t_end: float = math.inf) -> bool:
+        """One accepted step (redoing refused ones), at most up to ``t_end``; none, and False,
+        where the step would be shorter than ``handback_below`` (the hybrid's explicit steps
+        take it)."""
         st = self.st
         while True:
+            if self.dt < self.handback_below:
+                return False
             t = float(st.scalars.t[None])
             dt = self._limit(t, t_end)
             cut = dt < self.dt
@@ -153,24 +173,19 @@ class AdaptiveStepper:
             except NewtonError as e:
                 self._redo(before, dt, SHRINK**0.5 * dt, str(e))
                 continue
-            step_changes(st.points, self.before, self.changes, dt)
-            dT, de, dx = (float(x) for x in self.changes[None])
-            ratio = max(
-                dT / self.controls.temperature_K,
-                de / self.controls.strain,
-                dx / (self.controls.cells * st.cfg.h),
-            )
+            ratio = self.changes_ratio(dt)
             if ratio > REDO and dt > self.controls.dt_min:
+                dT, de, dx, dp = (float(x) for x in self.changes[None])
                 why = (
                     f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g}, "
-                    f"motion {dx / st.cfg.h:.3g} cells)"
+                    f"plastic strain {dp:.3g}, motion {dx / st.cfg.h:.3g} cells)"
                 )
                 self._redo(before, dt, next_step(dt, ratio, self.controls), why)
                 continue
             self.last_dt = dt
             if not (cut and ratio <= 1.0):
                 self.dt = next_step(dt, ratio, self.controls)
-            return
+            return True
 
     def _redo(self, before: dict[str, np.ndarray], dt: float, smaller: float, why: str) -> None:
         """Put the state back and make the next try ``smaller``; below dt_min, give up."""
@@ -189,13 +204,16 @@ class AdaptiveStepper:
     def advance(self, n: int) -> None:
         """n accepted steps."""
         for _ in range(n):
-            self.step()
+            if not self.step():
+                raise RuntimeError("AdaptiveStepper.advance: a hand-back needs the hybrid's loop")
 
     def advance_to(self, t_end: float, after_step: Callable[[], None] | None = None) -> int:
-        """Steps until the clock reaches ``t_end``; returns how many were taken."""
+        """Steps until the clock reaches ``t_end`` (or a hand-back); returns how many were
+        taken."""
         n = 0
         while float(self.st.scalars.t[None]) < t_end * (1.0 - 1e-12):
-            self.step(t_end)
+            if not self.step(t_end):
+                break
             n += 1
             if after_step is not None:
                 after_step()

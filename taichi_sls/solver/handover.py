@@ -13,6 +13,14 @@ its own. The hand-over falls at the end of a heat step (a multiple of ``heat_eve
 that no heat is lost; the thermal strain increment that the last explicit heat step spread over
 its mechanical steps has then been applied in full and is cleared for the implicit step, which
 sums its own.
+
+The hand-over is not one way. After it, contacts that form as a layer sinks (two melt surfaces
+snapping shut) are jumps that the controls follow at steps near the explicit one, where each
+implicit step costs a Newton solve. So when the adaptive step would fall below
+``time.handback_explicit_steps`` explicit steps, explicit steps take over again (their clocks
+aligned to start with a heat step), and every ``CHECK_S`` the changes over that stretch are
+read as if it had been one step: once a step of the proposed size meets the controls and is
+longer than the hand-back's bound, the implicit step resumes at that size.
 """
 
 import copy
@@ -20,7 +28,7 @@ import math
 from collections.abc import Callable
 
 from ..config import Case
-from .adaptive import AdaptiveStepper
+from .adaptive import AdaptiveStepper, copy_points, next_step
 from .fields import State
 from .scene import Scene
 from .step_config import step_config
@@ -54,7 +62,7 @@ def explicit_view(case: Case, state: State, scene: Scene, dt: float) -> State:
 
 
 class Handover:
-    """Which integrator steps now, and the moment to change (module docstring)."""
+    """Which integrator steps now, and the moments to change (module docstring)."""
 
     def __init__(
         self,
@@ -66,25 +74,63 @@ class Handover:
     ) -> None:
         self.view = view
         self.adaptive = adaptive
+        self.dt = dt
         self.lasers_off_s = case.lasers_off_s()
         self.fraction = case.time.handover_kinetic_fraction
         self.kinetic_ratio = kinetic_ratio
+        adaptive.handback_below = case.time.handback_explicit_steps * dt
         every = view.cfg.heat_every  # whole heat steps of the explicit phase, ~CHECK_S apart
         self.check_every = every * substeps_within(CHECK_S, dt * every)
         self.explicit = True
-        self.at_s = math.nan  # when the implicit step took over
+        self.stretch = 0  # explicit steps since the explicit phase began or the last check
+        self.stretch_s = 0.0  # when that stretch began (s)
+        self.at_s = math.nan  # when the implicit step first took over
+        self.handbacks = 0  # times explicit steps took over again
 
-    def steps_to_check(self, steps: int) -> int:
-        """Explicit steps from ``steps`` to the next check."""
-        return self.check_every - steps % self.check_every
+    def steps_to_check(self) -> int:
+        """Explicit steps to the next check."""
+        return self.check_every - self.stretch
 
     def check(self, t: float, steps: int) -> None:
-        """Hand over if the rule holds (at a check, after the explicit steps up to it)."""
-        if steps % self.check_every or t < self.lasers_off_s * (1 - 1e-12):
+        """After ``steps`` explicit steps: at a check, hand over if the rule holds (the first
+        time: every laser off and the motion died down; after a hand-back: the stretch since
+        the last check, read as one step, proposes a step the implicit one may take)."""
+        self.stretch += steps
+        if self.stretch < self.check_every:
             return
-        if self.kinetic_ratio() >= self.fraction:
+        self.stretch, start = 0, self.stretch_s
+        self.stretch_s = t
+        if t < self.lasers_off_s * (1 - 1e-12):
             return
-        st = self.adaptive.st
-        st.points.iso_strain_step.fill(0.0)
+        if self.handbacks == 0:
+            if self.kinetic_ratio() >= self.fraction:
+                return
+        else:
+            proposed = next_step(
+                t - start, self.adaptive.changes_ratio(t - start), self.adaptive.controls
+            )
+            if proposed < self.adaptive.handback_below:
+                copy_points(self.adaptive.st.points, self.adaptive.before)
+                return
+            self.adaptive.dt = proposed
+        self.adaptive.st.points.iso_strain_step.fill(0.0)
         self.explicit = False
-        self.at_s = t
+        if self.handbacks == 0:
+            self.at_s = t
+
+    def hand_back(self, t: float) -> None:
+        """Explicit steps take over again at t: the step counter raised to the next start of
+        a heat (and curvature) step, the explicit dt, a stretch begun."""
+        st = self.adaptive.st
+        every = math.lcm(self.view.cfg.heat_every, self.view.cfg.geom_every)
+        st.scalars.step[None] = -(-int(st.scalars.step[None]) // every) * every
+        st.scalars.dt[None] = self.dt
+        st.points.iso_strain_step.fill(0.0)  # the last implicit step's sum, already applied
+        self.explicit = True
+        self.restart_stretch(t)
+        self.handbacks += 1
+
+    def restart_stretch(self, t: float) -> None:
+        """A stretch of explicit steps begins at t: its starting points kept for its check."""
+        copy_points(self.adaptive.st.points, self.adaptive.before)
+        self.stretch, self.stretch_s = 0, t

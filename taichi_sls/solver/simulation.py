@@ -177,14 +177,20 @@ class Simulation(NeckMeasures):
 
     def advance_to(self, t: float) -> None:
         """Advance until the clock reaches t (s): adaptive steps that land on it, or the whole
-        fixed steps nearest to it."""
+        fixed steps nearest to it (hybrid, explicit after a hand-back: those that reach it)."""
         if self.adaptive is None:
             self.advance(round((t - self.t) / self.dt))
             return
-        while self.explicit_now and (n := round((t - self.t) / self.dt)) > 0:
-            self._explicit_steps(n)
-        if not self.explicit_now:
+        while self.t < t * (1.0 - 1e-12):
+            if self.explicit_now:  # after a hand-back the clock is off the explicit steps'
+                # grid: the whole steps that reach t (on the grid, the ones that land on it)
+                if (n := math.ceil((t - self.t) / self.dt - 1e-6)) <= 0:
+                    return
+                self._explicit_steps(n)
+                continue
             self.steps += self.adaptive.advance_to(t, self._after_step)
+            if self.t < t * (1.0 - 1e-12):  # stopped short: the explicit steps take over
+                self.handover.hand_back(self.t)
 
     def kinetic_ratio(self, kinetic_energy: float | None = None) -> float:
         """The kinetic energy (times the inertia scale; default: the points' now) over the
@@ -198,17 +204,30 @@ class Simulation(NeckMeasures):
             self.sort_points()
 
     def advance(self, n: int) -> None:
-        """Advance n steps (hybrid: explicit ones up to the hand-over, then implicit ones)."""
-        while n > 0 and self.handover is not None and self.handover.explicit:
-            n -= self._explicit_steps(n)
-        stepper = self.adaptive or self.implicit
-        self._advance(advance if stepper is None else lambda st, k: stepper.advance(k), None, n)
+        """Advance n steps (hybrid: explicit or implicit ones, as the hand-over says)."""
+        if self.handover is None:
+            stepper = self.adaptive or self.implicit
+            step = advance if stepper is None else lambda st, k: stepper.advance(k)
+            self._advance(step, None, n)
+            return
+        while n > 0:
+            if self.handover.explicit:
+                n -= self._explicit_steps(n)
+                continue
+            if self.before_step is not None:
+                self.before_step(self)
+            if self.adaptive.step():
+                self.steps += 1
+                n -= 1
+                self._after_step()
+            else:
+                self.handover.hand_back(self.t)
 
     def _explicit_steps(self, n: int) -> int:
         """Hybrid: explicit steps, at most n, up to the next check of the hand-over."""
-        k = min(n, self.handover.steps_to_check(self.steps))
+        k = min(n, self.handover.steps_to_check())
         self._advance(advance, self.handover.view, k)
-        self.handover.check(self.t, self.steps)
+        self.handover.check(self.t, k)
         return k
 
     def _advance(self, step: Callable, state: State | None, n: int) -> None:
@@ -302,8 +321,20 @@ class Simulation(NeckMeasures):
 
     # ------------------------------------------------------------------ state
     def save_checkpoint(self, path: Path, extra: dict | None = None) -> None:
-        """The full state, written atomically; ``extra`` (numbers) alongside, e.g. the frame."""
+        """The full state, written atomically; ``extra`` (numbers) alongside, e.g. the frame,
+        and the integrator's own state (the adaptive step's next size; the hybrid's phase)."""
+        extra = {**(extra or {}), **self._integrator_state()}
         checkpoint.save(self.state, path, self.steps, self.case.case.name, extra, self.point_order)
+
+    def _integrator_state(self) -> dict[str, float]:
+        out = {}
+        if self.adaptive is not None:
+            out["adaptive_dt"] = self.adaptive.dt
+        if self.handover is not None:
+            h = self.handover
+            out.update(hybrid_explicit=float(h.explicit), hybrid_at_s=h.at_s)
+            out["hybrid_handbacks"] = h.handbacks
+        return out
 
     def load_checkpoint(self, path: Path) -> dict:
         """Restore a state saved by :meth:`save_checkpoint`; returns its ``extra``. A run whose
@@ -314,7 +345,19 @@ class Simulation(NeckMeasures):
             self._permute(np.argsort(self.point_order)[saved])
         self.steps, extra = checkpoint.load(self.state, path, self.case.case.name)
         init_box(self.state)
-        self.dt = float(self.state.scalars.dt[None])
+        if self.adaptive is not None and "adaptive_dt" in extra:
+            self.adaptive.dt = float(extra.pop("adaptive_dt"))
+        if self.handover is None:
+            self.dt = float(self.state.scalars.dt[None])
+            return extra
+        h = self.handover  # the hybrid's dt stays its explicit step
+        if "hybrid_explicit" in extra:
+            h.explicit = bool(extra.pop("hybrid_explicit"))
+            h.at_s = float(extra.pop("hybrid_at_s"))
+            h.handbacks = int(extra.pop("hybrid_handbacks"))
+        if h.explicit:  # a stretch of explicit steps: its check starts again from here
+            self.state.scalars.dt[None] = self.dt
+            h.restart_stretch(self.t)
         return extra
 
     def snapshot(self, full: bool = False) -> dict[str, np.ndarray]:

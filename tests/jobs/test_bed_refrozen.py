@@ -50,6 +50,7 @@ def refrozen(tmp_path_factory):
             "time": {
                 "integrator": "hybrid",
                 "handover_kinetic_fraction": 1e-3,
+                "strain_control": "plastic",
                 "stop": "solidified",
                 "max_s": 0.5,
             },

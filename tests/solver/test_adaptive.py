@@ -3,6 +3,8 @@
 job that lands its frames and the laser's switch-off, and the heat against the erf solution at
 steps far beyond its explicit limit."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -54,8 +56,10 @@ def test_the_smallest_step_of_a_hybrid_is_its_explicit_step():
 
 def test_step_changes_measure_temperature_and_strain():
     """The strain increment is |F1 F0^-1 - I|: blind to the deformation a point already has
-    (a rotated, stretched F0), equal to the step's own increment; the temperature change is the
-    largest of any point."""
+    (a rotated, stretched F0), equal to the step's own increment; the plastic one is the
+    largest rise of the equivalent plastic strain (here of another point, so that the two
+    measures tell apart); the temperature change is the largest of any point. The ratio reads
+    the measure that time.strain_control names."""
     sim = Simulation(load_case("power25W_coarse", ADAPTIVE))
     n = sim.state.n_points
     rng = np.random.default_rng(3)
@@ -69,14 +73,27 @@ def test_step_changes_measure_temperature_and_strain():
     sim.adaptive.before.T.from_numpy(T)
     F[7] = (np.eye(2) + e) @ F0
     T[11] -= 2.5
+    plastic = np.full(n, 0.3)
+    sim.adaptive.before.equivalent_plastic_strain.from_numpy(plastic)
+    plastic[5] += 0.004
     sim.state.points.F.from_numpy(F)
     sim.state.points.T.from_numpy(T)
+    sim.state.points.equivalent_plastic_strain.from_numpy(plastic)
     sim.state.points.v.fill(0.0)
     step_changes(sim.state.points, sim.adaptive.before, sim.adaptive.changes, 1e-6)
-    dT, de, dx = sim.adaptive.changes[None]
+    dT, de, dx, dp = sim.adaptive.changes[None]
     assert dT == pytest.approx(2.5)
     assert de == pytest.approx(np.linalg.norm(e), rel=1e-10)
     assert dx == 0.0
+    assert dp == pytest.approx(0.004, rel=1e-10)
+    c = sim.adaptive.controls
+    assert sim.adaptive.changes_ratio(1e-6) == pytest.approx(
+        max(2.5 / c.temperature_K, de / c.strain)
+    )
+    sim.adaptive.controls = dataclasses.replace(c, plastic=True)
+    assert sim.adaptive.changes_ratio(1e-6) == pytest.approx(
+        max(2.5 / c.temperature_K, dp / c.strain)
+    )
 
 
 def test_laser_switch_times():
