@@ -1,7 +1,8 @@
 """A bed run to refreezing through the main job (issue #22): the six-disc CSV bed of
 test_bed_outcome under a 25 W track, with the bed's melt reading (a zero-yield melt with Table 3's
-viscosity, as in sweeps/bed_map.toml) and the hybrid integrator: explicit steps through the track,
-then adaptive implicit ones while the layer cools to the plate and refreezes (about 40 s)."""
+viscosity) and the integrator of cases/bed_track.toml (the hybrid, its step controlled by the
+plastic strain, light nodes at rest): explicit steps through the track, then adaptive implicit
+ones while the layer cools to the plate and refreezes (about 40 s)."""
 
 import csv
 import json
@@ -13,7 +14,7 @@ from test_bed_outcome import DISCS, H_UM, TANGENT
 
 from taichi_sls.jobs.case_run import run_case
 
-# the melt of sinter_hold.toml and of sweeps/bed_map.toml: zero yield, Table 3's viscosity
+# the melt of sinter_hold.toml and of cases/bed_track.toml: zero yield, Table 3's viscosity
 MELT = {
     "youngs_liquid_Pa": 2.9e5,
     "poisson_liquid": 0.45,
@@ -51,6 +52,7 @@ def refrozen(tmp_path_factory):
                 "integrator": "hybrid",
                 "handover_kinetic_fraction": 1e-3,
                 "strain_control": "plastic",
+                "implicit_small_mass": 1e-2,
                 "stop": "solidified",
                 "max_s": 0.5,
             },
