@@ -85,6 +85,7 @@ def test_hybrid_takes_the_implicit_restrictions():
         load_case("power25W_coarse", ["time.integrator=hybrid", "surface_tension.method=csf"])
 
 
+@pytest.mark.slow  # a hybrid run to refreezing with verdicts: tests/jobs/test_bed_refrozen.py
 def test_a_hybrid_run_to_refreezing_gives_its_verdict(tmp_path):
     """The coarse 25 W pair to refreezing as the main job: complete, with the unheated
     baseline (itself run hybrid, landing on fusion.baseline_s) within 1 % of the explicit

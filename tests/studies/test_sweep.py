@@ -119,6 +119,7 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+@pytest.mark.slow  # a second scheduler path; the local Dask runner is tested above
 def test_sweep_on_existing_scheduler(tmp_path):
     port = _free_port()
     addr = f"tcp://127.0.0.1:{port}"
