@@ -98,19 +98,17 @@ class Handover:
         self.stretch += steps
         if self.stretch < self.check_every:
             return
-        self.stretch, start = 0, self.stretch_s
-        self.stretch_s = t
+        length = t - self.stretch_s
+        ratio = self.adaptive.changes_ratio(length) if self.handbacks else math.nan
+        self.restart_stretch(t)
         if t < self.lasers_off_s * (1 - 1e-12):
             return
         if self.handbacks == 0:
             if self.kinetic_ratio() >= self.fraction:
                 return
         else:
-            proposed = next_step(
-                t - start, self.adaptive.changes_ratio(t - start), self.adaptive.controls
-            )
+            proposed = next_step(length, ratio, self.adaptive.controls)
             if proposed < self.adaptive.handback_below:
-                copy_points(self.adaptive.st.points, self.adaptive.before)
                 return
             self.adaptive.dt = proposed
         self.adaptive.st.points.iso_strain_step.fill(0.0)
