@@ -332,8 +332,9 @@ class Simulation(NeckMeasures):
             out["adaptive_dt"] = self.adaptive.dt
         if self.handover is not None:
             h = self.handover
-            out.update(hybrid_explicit=float(h.explicit), hybrid_at_s=h.at_s)
-            out["hybrid_handbacks"] = h.handbacks
+            out.update(
+                hybrid_explicit=float(h.explicit), hybrid_at_s=h.at_s, hybrid_handbacks=h.handbacks
+            )
         return out
 
     def load_checkpoint(self, path: Path) -> dict:
