@@ -125,10 +125,12 @@ class Handover:
         st.scalars.dt[None] = self.dt
         st.points.iso_strain_step.fill(0.0)  # the last implicit step's sum, already applied
         self.explicit = True
-        self.restart_stretch(t)
         self.handbacks += 1
+        self.restart_stretch(t)
 
     def restart_stretch(self, t: float) -> None:
-        """A stretch of explicit steps begins at t: its starting points kept for its check."""
-        copy_points(self.adaptive.st.points, self.adaptive.before)
+        """A stretch of explicit steps begins at t; after a hand-back its starting points are
+        kept for its check (before the first hand-over the kinetic rule needs none)."""
+        if self.handbacks:
+            copy_points(self.adaptive.st.points, self.adaptive.before)
         self.stretch, self.stretch_s = 0, t
