@@ -31,6 +31,14 @@ class Bed(Model):
     both (the generated discs land on the CSV's). Added after the ``[[bodies]]``; the resolved
     case lists every disc as a body."""
 
+    previous_layer: str | None = Field(
+        None,
+        description="layer file (the layer.npz a bed run writes to its output folder), relative "
+        "to the case file: its points become bodies (one per body of that run) as they ended, at "
+        "rest with the deformation and stress they ended with, at bed.temperature_C, and the new "
+        "discs are deposited onto them "
+        "(each point a disc of its square's half-side); run it on the same grid",
+    )
     csv: str | None = Field(
         None,
         description="CSV file of discs (um), relative to the case file: a header naming the "
@@ -81,7 +89,7 @@ class Bed(Model):
         "beyond it is an error. Also the gap within which a particle rests on another",
     )
 
-    @field_validator("csv", "sizes_csv")
+    @field_validator("csv", "sizes_csv", "previous_layer")
     @classmethod
     def _readable(cls, v: str | None) -> str | None:
         if v is not None and not Path(v).is_file():

@@ -1,5 +1,5 @@
-"""Bodies of a case: discs, rectangles and polygons, each seeded with material points (lengths
-in um)."""
+"""Bodies of a case: discs, rectangles and polygons, each seeded with material points, and the
+bodies of a previous layer, whose points are read from its layer file (lengths in um)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,10 @@ import math
 from pathlib import Path
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import Field, field_validator
 
+from .layer_file import read_layer
 from .model import Model, Pair
 
 
@@ -21,7 +23,7 @@ class BodyBase(Model):
 
 
 class Disc(BodyBase):
-    shape: Literal["disc"] = Field("disc", description="disc, rect or polygon")
+    shape: Literal["disc"] = Field("disc", description="disc, rect, polygon or points")
     center_um: Pair = Field([20.0, 20.0], description="disc centre (um)")
     radius_um: float = Field(20.0, gt=0, description="disc radius (um)")
     perturbation: float = Field(
@@ -41,7 +43,7 @@ class Disc(BodyBase):
 
 
 class Rect(BodyBase):
-    shape: Literal["rect"] = Field(description="disc, rect or polygon")
+    shape: Literal["rect"] = Field(description="disc, rect, polygon or points")
     min_um: Pair = Field([0.0, 0.0], description="rectangle lower-left corner (um)")
     max_um: Pair = Field([10.0, 10.0], description="rectangle upper-right corner (um)")
 
@@ -53,7 +55,7 @@ class Rect(BodyBase):
 
 
 class Polygon(BodyBase):
-    shape: Literal["polygon"] = Field(description="disc, rect or polygon")
+    shape: Literal["polygon"] = Field(description="disc, rect, polygon or points")
     vertices_um: list[Pair] = Field(
         [],
         description="outline vertices [[x, y], ...] (um), in order, either sense; or give "
@@ -93,4 +95,47 @@ class Polygon(BodyBase):
         return sum(math.dist(v[i], v[i - 1]) for i in range(len(v)))
 
 
-Body = Annotated[Disc | Rect | Polygon, Field(discriminator="shape")]
+class LayerBody(BodyBase):
+    """One body of a previous layer: its points as that run left them (positions, volumes, and
+    where the file carries them their deformation and stress), placed at rest; the case's
+    ``bed.previous_layer`` lists one per body."""
+
+    shape: Literal["points"] = Field(description="disc, rect, polygon or points")
+    file: str = Field(description="layer file (layer.npz of a bed run), relative to the case file")
+    body: int = Field(0, ge=0, description="which body of the layer file")
+
+    @field_validator("file")
+    @classmethod
+    def _readable(cls, v: str) -> str:
+        if not Path(v).is_file():
+            raise ValueError("no such file")
+        return v
+
+    def points_um(self) -> tuple[np.ndarray, np.ndarray]:
+        """(positions (n, 2), volumes (n,)) of the body's points (um, um^2)."""
+        return read_layer(self.file, "bodies[].file").of_body(self.body)
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        x, vol = self.points_um()
+        half = 0.5 * np.sqrt(vol)
+        lo, hi = (x - half[:, None]).min(axis=0), (x + half[:, None]).max(axis=0)
+        return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
+
+    def carried_state(self) -> tuple[np.ndarray, dict[str, np.ndarray]] | None:
+        """(seeded volumes (um^2), the points' deformation and stress members) as the layer's
+        run left them, or None where the file does not carry them (config/layer_file.py)."""
+        return read_layer(self.file, "bodies[].file").state_of_body(self.body)
+
+    def centres_extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """The box of the points themselves (their squares may reach a hair into a wall that
+        the run pressed them against)."""
+        x, _ = self.points_um()
+        lo, hi = x.min(axis=0), x.max(axis=0)
+        return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
+
+    def perimeter_um(self) -> float:
+        """The perimeter of the circle of the body's area (a lower bound of its outline)."""
+        return 2.0 * math.sqrt(math.pi * float(np.sum(self.points_um()[1])))
+
+
+Body = Annotated[Disc | Rect | Polygon | LayerBody, Field(discriminator="shape")]

@@ -8,14 +8,16 @@ solver converts to SI (m, K) when it builds its fields. Every check runs here, b
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from pydantic import Field, PrivateAttr, model_validator
 
 from .bed import Bed, bed_discs
-from .bodies import Body, Disc
+from .bodies import Body, Disc, LayerBody
 from .errors import CaseError
+from .layer_file import read_layer
 from .materials import Material
 from .model import Model, Pair
 from .numerics import Solver, Time
@@ -92,8 +94,21 @@ class Case(Model):
         W = self.domain.width_um if "width_um" in given else None
         H = self.domain.height_um if "height_um" in given else None
         old = [[*b.center_um, b.radius_um] for b in self.bodies if b.shape == "disc"]
+        old = np.array(old, dtype=float).reshape(-1, 3)
+        below = self._previous_layer(bed)
+        if below:  # the new discs land on the layer's points, each a disc in its square
+            layer = read_layer(bed.previous_layer)
+            old = np.concatenate([old, np.column_stack([layer.x_um, 0.5 * layer.spacing_um()])])
         join = 2.0 * self.contact.fillet_radius_um if self.contact.initial == "fillet" else 0.0
-        discs = bed_discs(bed, np.array(old, dtype=float).reshape(-1, 3), W, H, join)
+        discs = bed_discs(bed, old, W, H, join)
+        if below:  # the generator's fractions would count the layer below as void
+            discs.report.update(
+                envelope=math.nan,
+                bulk=math.nan,
+                previous_layer=Path(bed.previous_layer).name,
+                previous_layer_bodies=len(below),
+                previous_layer_points=len(layer.volume_um2),
+            )
         h = self.grid.spacing_um
         if W is None:
             right = max(discs.report["x_range_um"][1], float(np.max(discs.x + discs.r)))
@@ -103,6 +118,7 @@ class Case(Model):
             self.domain.height_um = h * math.ceil(top / h - 1e-9)
         self.bodies = [
             *self.bodies,
+            *below,
             *(
                 Disc(
                     center_um=[float(x), float(y)],
@@ -115,6 +131,41 @@ class Case(Model):
         ]
         self.bed = None
         self._bed_report = discs.report
+
+    def _previous_layer(self, bed: Bed) -> list[LayerBody]:
+        """The bodies of ``bed.previous_layer`` (none without one), checked against the case:
+        their materials exist and their points were seeded at this case's point spacing."""
+        if bed.previous_layer is None:
+            return []
+        layer = read_layer(bed.previous_layer)
+        key = f"bed.previous_layer = {bed.previous_layer!r}"
+        spacing = self.grid.spacing_um / self.grid.points_per_cell
+        seeded = float(np.median(layer.spacing_um()))  # most are whole points
+        if not 0.8 * spacing <= seeded <= 1.25 * spacing:
+            raise CaseError(
+                f"{key}: its points are {seeded:.3g} um apart, this case seeds them "
+                f"{spacing:.3g} um apart (grid.spacing_um / grid.points_per_cell); allowed: a "
+                "layer run on the same grid"
+            )
+        out = []
+        for b in layer.bodies:
+            names = {layer.material_names[m] for m in np.unique(layer.material[layer.body == b])}
+            missing = sorted(names - set(self.materials))
+            if missing:
+                raise CaseError(
+                    f"{key}: body {b} is of material {missing[0]!r}, not defined here; "
+                    f"defined: {', '.join(self.materials)}"
+                )
+            out.append(
+                LayerBody(
+                    shape="points",
+                    file=bed.previous_layer,
+                    body=int(b),
+                    material=sorted(names)[0],
+                    temperature_C=bed.temperature_C,
+                )
+            )
+        return out
 
     def bed_report(self) -> dict | None:
         """The [bed] this case was built from: source, disc count, packing fractions
@@ -160,12 +211,16 @@ class Case(Model):
                 )
             if b.shape == "rect" and not (b.max_um[0] > b.min_um[0] and b.max_um[1] > b.min_um[1]):
                 raise CaseError(f"{key}.max_um = {b.max_um}: must exceed min_um = {b.min_um}")
+            if b.shape == "points" and len(b.points_um()[1]) == 0:
+                raise CaseError(
+                    f"{key}.body = {b.body}: the layer file {b.file!r} has no such body"
+                )
             if b.shape == "polygon" and len(b.outline_um()) < 3:
                 raise CaseError(
                     f"{key}.vertices_um: {len(b.outline_um())} vertices; a polygon needs at "
                     "least 3 (or a vertices_file)"
                 )
-            lo, hi = b.extent()
+            lo, hi = b.centres_extent() if b.shape == "points" else b.extent()
             if lo[0] < -eps or lo[1] < -eps or hi[0] > W + eps or hi[1] > Hh + eps:
                 raise CaseError(
                     f"{key}: extent x {lo[0]}..{hi[0]}, y {lo[1]}..{hi[1]} um lies outside the "

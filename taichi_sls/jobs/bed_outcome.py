@@ -28,6 +28,7 @@ Per contact (a, b) of ``Simulation.contacts``:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -183,7 +184,7 @@ def bed_summary(
         pt.x0.to_numpy(), pt.time_molten.to_numpy(), sim.case.top_um() * 1e-6, spacing
     )
     rep = sim.case.bed_report() or {}
-    return {
+    record = {
         "contacts": n,
         "fused": int(col["fused"].sum()),
         "fused_fraction": float(col["fused"].mean()) if n else math.nan,
@@ -209,6 +210,22 @@ def bed_summary(
         "track_width_um": melt["track_width_m"] * 1e6,
         "molten_points": melt["molten_points"],
     }
+    laid = np.array([b.shape == "points" for b in sim.case.bodies])
+    if laid.any():  # on a previous layer: the contacts the new discs made, apart
+        a, b = (np.array([int(r[k]) for r in rows], dtype=int) for k in ("body_a", "body_b"))
+        new = ~(laid[a] & laid[b]) if n else np.zeros(0, dtype=bool)
+        across = laid[a] != laid[b] if n else np.zeros(0, dtype=bool)
+        through = np.array([r["melted_through"] for r in rows], dtype=bool)
+        record["new_layer"] = {
+            "contacts": int(new.sum()),
+            "fused": int(col["fused"][new].sum()),
+            "fused_fraction": float(col["fused"][new].mean()) if new.any() else math.nan,
+            "on_previous_layer": int(across.sum()),
+            "on_previous_layer_melted_through": int(through[across].sum()),
+            "on_previous_layer_fused": int(col["fused"][across].sum()),
+            **{k: _quartiles(col[k][new]) for k in NECKS},
+        }
+    return record
 
 
 def describe_bed(b: dict[str, Any]) -> str:
@@ -239,5 +256,21 @@ def describe_bed(b: dict[str, Any]) -> str:
         f"  melt track: depth {b['melt_depth_um']:.1f} um below the top at "
         f"{b['layer_top_um']:.1f} um (down to {um(b['melt_bottom_um'])} above the plate), "
         f"width {b['track_width_um']:.1f} um "
-        f"({b['molten_points']} points ever fully molten)\n  rule: {b['rule']}"
+        f"({b['molten_points']} points ever fully molten)\n"
+        + _describe_new_layer(b.get("new_layer"), num)
+        + f"  rule: {b['rule']}"
+    )
+
+
+def _describe_new_layer(nl: dict[str, Any] | None, num: Callable[[Any, str], str]) -> str:
+    """The line on the new layer's own contacts (a bed on a previous layer), else nothing."""
+    if nl is None:
+        return ""
+    neck = nl["neck_final_um"]
+    return (
+        f"  new layer: {nl['contacts']} contacts, {nl['fused']} fused "
+        f"({num(nl['fused_fraction'], '.0%')}), final neck median {num(neck['median'], '.2f')} "
+        f"um; on the layer below: {nl['on_previous_layer']} contacts, "
+        f"{nl['on_previous_layer_melted_through']} melted through, "
+        f"{nl['on_previous_layer_fused']} fused\n"
     )

@@ -4,8 +4,9 @@ Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``
 ``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``outcome.png``,
 ``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
 ``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed) adds
-``contacts.csv`` and ``contacts.png`` and the summary's ``bed`` record (jobs/bed_outcome.py),
-its verdict per contact. Every file is written atomically; an interrupted or
+``contacts.csv`` and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py),
+its verdict per contact, and ``layer.npz``, its points at the end (``bed.previous_layer`` of a
+next layer). Every file is written atomically; an interrupted or
 failed run still leaves valid files and a summary that says so.
 """
 
@@ -20,11 +21,14 @@ from pathlib import Path
 from typing import Any
 
 from ..config import Case, case_to_toml
+from ..config.layer_file import CARRIED_STATE
 from ..io.contacts_plot import plot_contacts
 from ..io.contacts_table import read_contacts, write_contacts
+from ..io.layer_output import write_layer
 from ..io.outcome_plot import plot_outcome
 from ..io.vtu import point_data
 from ..io.writer import OutputWriter
+from ..physics.materials import KELVIN
 from ..solver.guard import SimulationError
 from ..solver.scene import Scene
 from ..solver.simulation import Simulation
@@ -37,6 +41,7 @@ from .unheated import needs_baseline, unheated_neck_um
 # statuses: complete (end_s reached, or solidified and settled), max_time (stop = solidified
 # gave up at time.max_s), failed (the guard), interrupted (Ctrl-C, SIGTERM)
 STATUSES = ("complete", "max_time", "failed", "interrupted")
+LAYER_FILE = "layer.npz"  # a bed run's points at its end: the next layer's base
 
 
 def _writer(case: Case, out_dir: Path) -> OutputWriter:
@@ -251,6 +256,9 @@ def run_case(
                 write_contacts(out_dir / "contacts.csv", rows)
                 summary["bed"] = bed_summary(sim, rows, bed.density_initial)
                 plot_contacts(out_dir, rows, pt.x.to_numpy() * 1e6)
+                if summary["status"] != "failed":  # the layer a next one is deposited on
+                    write_layer_file(out_dir / LAYER_FILE, sim, summary["status"])
+                    summary["layer_file"] = LAYER_FILE
             except Exception as e:  # noqa: BLE001 -- never cost the run's other outputs
                 warnings.append(f"bed outcome not made ({type(e).__name__}: {e})")
         if summary["status"] == "max_time":
@@ -278,6 +286,23 @@ def run_case(
         except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
             print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)
     return summary
+
+
+def write_layer_file(path: Path, sim: Simulation, status: str) -> None:
+    """The points as they are now, for a case that deposits a layer on them (bed.previous_layer)."""
+    pt, sc = sim.state.points, sim.scene
+    write_layer(
+        path,
+        x_um=pt.x.to_numpy() * 1e6,
+        volume_um2=pt.volume0.to_numpy() * pt.J.to_numpy() * 1e12,
+        body=sc.body,
+        material=sc.material,
+        material_names=sc.material_names,
+        T_C=pt.T.to_numpy() - KELVIN,
+        info={"case": sim.case.case.name, "t_s": sim.t, "status": status},
+        volume0_um2=pt.volume0.to_numpy() * 1e12,
+        state={k: getattr(pt, k).to_numpy() for k in CARRIED_STATE},
+    )
 
 
 def complete_summary(

@@ -225,6 +225,12 @@ class State:
         self._init_points()
         if np.any(sc.p0 != 0.0):
             self._prestress(sc.p0)
+        if sc.carried is not None:  # a previous layer's points keep their deformation and stress
+            for name, values in sc.carried_state.items():
+                field = getattr(self.points, name)
+                now = field.to_numpy()
+                now[sc.carried] = values[sc.carried]
+                field.from_numpy(now)
 
     @ti.kernel
     def _init_points(self):

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..config import Case, CaseError
 from .contacts import fillet, in_bridge
+from .layer_contact import LayerPoints, layer_bridges
 
 PAD = 2  # cells of array margin beyond the ghost layer
 AREA_SAMPLES = 8  # grid.seeding = "area": sub-points per point square along each axis
@@ -36,6 +37,9 @@ class Scene:
     p0: np.ndarray  # (N,) initial in-plane pressure (Pa): surface_tension.initial_stress
     material_names: list[str]
     table1_nodes: int  # nodes of domain plus ghost layer (what the paper's Table 1 counts)
+    # a previous layer's points: which carry their state, and the members' values (N, ...)
+    carried: np.ndarray | None = None
+    carried_state: dict[str, np.ndarray] | None = None
 
     @property
     def n_points(self) -> int:
@@ -44,7 +48,11 @@ class Scene:
     def reordered(self, order: np.ndarray) -> Scene:
         """The same points in another order (the speed benchmark shuffles them)."""
         per_point = ("x", "vol", "body", "material", "T0_C", "v0", "p0")
-        return Scene(**{**vars(self), **{k: getattr(self, k)[order] for k in per_point}})
+        moved = {k: getattr(self, k)[order] for k in per_point}
+        if self.carried is not None:
+            moved["carried"] = self.carried[order]
+            moved["carried_state"] = {k: v[order] for k, v in self.carried_state.items()}
+        return Scene(**{**vars(self), **moved})
 
 
 def inside_polygon(vertices: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
@@ -61,6 +69,8 @@ def inside_polygon(vertices: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.n
 
 
 def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    if body.shape == "points":  # a previous layer's points are placed, not seeded
+        return np.zeros(px.shape, dtype=bool)
     if body.shape == "disc":
         cx, cy = body.center_um
         dx, dy = px - cx, py - cy
@@ -73,15 +83,22 @@ def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
     return (px > x0) & (px < x1) & (py > y0) & (py < y1)
 
 
-def _owners(case: Case, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+def _owners(case: Case, px: np.ndarray, py: np.ndarray, spacing: float) -> np.ndarray:
     """The body each candidate point belongs to (-1: none): the first body that holds it, and
-    with ``contact.initial = "fillet"`` the bridges between discs, each bridge point given to
-    the disc whose outline is nearer."""
+    with ``contact.initial = "fillet"`` the bridges between discs, and between a disc and a
+    previous layer, each bridge point given to the body whose outline is nearer. No candidate
+    is seeded within a previous layer point's cell (its points are its own)."""
     owner = np.full(px.shape, -1, dtype=np.int64)
+    layer = LayerPoints.of_case(case)
+    taken = layer.covers(px, py, 0.5 * spacing)
+    owner[taken] = -2
     for bi, b in enumerate(case.bodies):
-        owner[(owner < 0) & _inside(b, px, py)] = bi
+        owner[(owner == -1) & _inside(b, px, py)] = bi
     if case.contact.initial != "fillet":
+        owner[taken] = -1
         return owner
+    if len(layer):
+        layer_bridges(case, layer, px, py, owner, spacing)
     rho = case.contact.fillet_radius_um
     discs = [(i, b) for i, b in enumerate(case.bodies) if b.shape == "disc" and not b.perturbation]
     for k, (ia, a) in enumerate(discs):
@@ -89,11 +106,12 @@ def _owners(case: Case, px: np.ndarray, py: np.ndarray) -> np.ndarray:
             f = fillet(a.center_um, a.radius_um, b.center_um, b.radius_um, rho)
             if f is None:
                 continue
-            free = owner < 0
+            free = owner == -1
             sel = free & in_bridge(f, a.center_um, b.center_um, px, py)
             da = np.hypot(px - a.center_um[0], py - a.center_um[1]) - a.radius_um
             db = np.hypot(px - b.center_um[0], py - b.center_um[1]) - b.radius_um
             owner[sel] = np.where(da[sel] <= db[sel], ia, ib)
+    owner[taken] = -1
     return owner
 
 
@@ -110,12 +128,12 @@ def _seed(
     instead of the staircase of +-spacing/2 that a centre test leaves, which moves a narrow
     neck's reading by up to a point spacing at every h."""
     if case.grid.seeding == "centre":
-        owner = _owners(case, px, py)
+        owner = _owners(case, px, py, spacing)
         return owner, np.ones(px.shape)
     k = AREA_SAMPLES
     u = ((np.arange(k) + 0.5) / k - 0.5) * spacing
     du, dv = (a.ravel() for a in np.meshgrid(u, u, indexing="ij"))
-    sub = _owners(case, (px[:, None] + du).ravel(), (py[:, None] + dv).ravel())
+    sub = _owners(case, (px[:, None] + du).ravel(), (py[:, None] + dv).ravel(), spacing)
     sub = sub.reshape(len(px), k * k)
     counts = np.stack([(sub == b).sum(axis=1) for b in range(len(case.bodies))], axis=1)
     held = counts.sum(axis=1)
@@ -153,18 +171,27 @@ def build_scene(case: Case) -> Scene:
     PX, PY = PX.ravel(), PY.ravel()
     names = list(case.materials)
     xs, bodies, mats, temps, vels, pres, fills = [], [], [], [], [], [], []
+    carried: list[tuple[int, dict[str, np.ndarray]]] = []  # (first point, members)
     owner, fill = _seed(case, PX, PY, h_um / n)
     for bi, b in enumerate(case.bodies):
         sel = owner == bi
-        k = int(sel.sum())
+        xy, f = np.stack([PX[sel], PY[sel]], axis=1), fill[sel]
+        if b.shape == "points":  # a previous layer's body: its points, and its fillets' seeded
+            placed, vol = b.points_um()
+            state = b.carried_state()
+            if state is not None:  # the volumes they were seeded with, deformed by their F
+                vol = state[0]
+                carried.append((sum(len(a) for a in fills), state[1]))
+            xy, f = np.concatenate([placed, xy]), np.concatenate([vol / (h_um / n) ** 2, f])
+        k = len(f)
+        xs.append(xy)
+        fills.append(f)
         if k == 0:
             raise CaseError(
                 f"bodies[{bi}]: holds no material point at grid.spacing_um = {h_um} "
                 f"({case.grid.points_per_cell}x{case.grid.points_per_cell} per cell); make it "
                 "larger or the grid finer"
             )
-        xs.append(np.stack([PX[sel], PY[sel]], axis=1))
-        fills.append(fill[sel])
         bodies.append(np.full(k, bi, dtype=np.int32))
         mats.append(np.full(k, names.index(b.material), dtype=np.int32))
         T = case.thermal.initial_C if b.temperature_C is None else b.temperature_C
@@ -172,6 +199,7 @@ def build_scene(case: Case) -> Scene:
         vels.append(np.tile(np.asarray(b.velocity_m_s, dtype=float), (k, 1)))
         pres.append(np.full(k, laplace_pressure(case, b)))
     x = np.concatenate(xs) * 1e-6
+    mask, state = _carried(carried, len(x))
     g = case.grid.ghost_cells
     off = g + PAD
     h = h_um * 1e-6
@@ -191,4 +219,23 @@ def build_scene(case: Case) -> Scene:
         p0=np.concatenate(pres),
         material_names=names,
         table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g),
+        carried=mask,
+        carried_state=state,
     )
+
+
+def _carried(
+    parts: list[tuple[int, dict[str, np.ndarray]]], n: int
+) -> tuple[np.ndarray | None, dict[str, np.ndarray] | None]:
+    """The carried state of a previous layer's points as whole-scene arrays (zeros elsewhere)
+    and which points it holds; (None, None) without any."""
+    if not parts:
+        return None, None
+    mask = np.zeros(n, dtype=bool)
+    state = {k: np.zeros((n, *v.shape[1:])) for k, v in parts[0][1].items()}
+    for start, members in parts:
+        m = len(next(iter(members.values())))
+        mask[start : start + m] = True
+        for k, v in members.items():
+            state[k][start : start + m] = v
+    return mask, state
