@@ -213,8 +213,7 @@ def bed_summary(
     laid = np.array([b.shape == "points" for b in sim.case.bodies])
     if laid.any():  # on a previous layer: the contacts the new discs made, apart
         a, b = (np.array([int(r[k]) for r in rows], dtype=int) for k in ("body_a", "body_b"))
-        new = ~(laid[a] & laid[b]) if n else np.zeros(0, dtype=bool)
-        across = laid[a] != laid[b] if n else np.zeros(0, dtype=bool)
+        new, across = ~(laid[a] & laid[b]), laid[a] != laid[b]
         through = np.array([r["melted_through"] for r in rows], dtype=bool)
         record["new_layer"] = {
             "contacts": int(new.sum()),
