@@ -80,6 +80,13 @@ class Time(Model):
         "ones once every laser is off and the kinetic energy is below "
         "handover_kinetic_fraction of the surface energy (solver/handover.py)",
     )
+    implicit_scheme: Literal["backward_euler", "extrapolated"] = Field(
+        "backward_euler",
+        description="implicit: backward_euler (first order, one Newton solve a step); "
+        "extrapolated: each step taken whole and as two halves, the points' mechanics "
+        "extrapolated to 2 halves - whole (Richardson: second order and, like backward Euler, "
+        "damping stiff modes; three solves a step; solver/extrapolation.py)",
+    )
     handover_kinetic_fraction: float = Field(
         1e-5,
         gt=0,

@@ -16,6 +16,7 @@ from . import checkpoint
 from .adaptive import AdaptiveStepper
 from .blocks import BlockPlan
 from .contacts import touching
+from .extrapolation import ExtrapolatedStepper
 from .fields import State
 from .guard import Guard
 from .handover import Handover, explicit_view
@@ -116,6 +117,8 @@ class Simulation(NeckMeasures):
         if cfg.implicit:
             self.state.scalars.dt_heat[None] = dt_heat
             self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
+            if case.time.implicit_scheme == "extrapolated":
+                self.implicit = ExtrapolatedStepper(self.implicit)
             if case.step_adapts():  # hybrid: from implicit_step_factor x its dt
                 dt0 = self.dt * (case.time.implicit_step_factor if hybrid else 1.0)
                 longest = heat_step_max(case)
