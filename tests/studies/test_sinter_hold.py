@@ -26,7 +26,10 @@ def test_hopper_at_a_constant_temperature_is_hoppers_clock():
     assert np.allclose(pred[after], neck[after], rtol=1e-9)
 
 
-@pytest.mark.parametrize("strain_control", ["total", "plastic"])
+# the plastic control runs on request: the default suite keeps the bundled case's own control
+@pytest.mark.parametrize(
+    "strain_control", ["total", pytest.param("plastic", marks=pytest.mark.slow)]
+)
 def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path, strain_control):
     """The bundled case for its second (the implicit integrator, adaptive steps, backward-Euler
     heat): the pulse melts the pair, it cools to the 170 C bed and stays molten (it crystallises
