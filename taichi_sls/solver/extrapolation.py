@@ -74,7 +74,7 @@ class ExtrapolatedStepper:
         return self.inner.newton_total
 
     def compile(self) -> None:
-        self.inner.compile()
+        self.inner.compile(self)
 
     def advance(self, n: int) -> None:
         for _ in range(n):

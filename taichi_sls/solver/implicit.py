@@ -47,6 +47,7 @@ from ..physics.stiffness import (
     scatter_point_tangent,
     stencil_offset,
 )
+from . import checkpoint
 from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
@@ -56,6 +57,7 @@ from .step import (
     advance_clock,
     clear_grid,
     g2p_point_mechanics,
+    init_box,
     p2g,
     point_stencil,
     surface_force,
@@ -68,6 +70,8 @@ LINE_SEARCH_HALVINGS = 8
 # the relative residual of a Newton step's linear solve (an inexact Newton direction: the
 # iteration itself drives the momentum residual to time.newton_tolerance)
 LINEAR_RTOL = 1e-6
+# the warm-up step that compiles the kernels, as a fraction of the step (ImplicitStepper.compile)
+WARM_UP_FRACTION = 1e-3
 
 
 class NewtonError(SimulationError):
@@ -267,18 +271,28 @@ class ImplicitStepper:
         for _ in range(n):
             self.step()
 
-    def compile(self) -> None:
-        """Compile the step's kernels that touch only the grid, by running them once on the
-        points as they are (the grid is scratch, rebuilt by every step); the heat substep and
-        the G2P compile on the first step."""
+    def compile(self, stepper: "ImplicitStepper | None" = None) -> None:
+        """Compile every kernel of the step (of ``stepper``'s, which wraps this one) by taking
+        a step of WARM_UP_FRACTION of dt from the state as it is and putting everything it
+        changed back: so that the run's first implicit step, a hybrid's hand-over, does not pay
+        seconds of compilation inside its stepping time."""
         st = self.st
-        begin(st)
-        none = np.empty((0, 3), dtype=np.int32)
-        internal_force(st, np.empty(0), none)
-        rows = np.empty((0, self._slots))
-        gather(
-            st, st.implicit.fixed, none, rows.astype(np.int32), rows, np.empty(0), np.empty(0), True
-        )
+        saved = checkpoint.capture(st)
+        scalars = st.scalars.to_numpy()
+        sort = int(st.blocks.needs_sort[None]) if st.blocks is not None else 0
+        st.scalars.dt[None] = WARM_UP_FRACTION * float(scalars["dt"])
+        st.scalars.dt_heat[None] = WARM_UP_FRACTION * float(scalars["dt_heat"])
+        try:
+            (stepper or self).step()
+        except SimulationError:
+            pass  # compiled as far as it went; the run's own step reports a failure
+        checkpoint.restore(st, saved)
+        st.scalars.from_numpy(scalars)
+        if st.blocks is not None:
+            st.blocks.needs_sort[None] = sort
+        init_box(st)
+        self.last, self.newton_total, self.linear = StepReport(), 0, None
+        self.heat.linear = None
 
     def step(self) -> None:
         sys_ = self.prepare()
