@@ -13,7 +13,9 @@ The extrapolation holds for any first-order step, so it needs nothing of the ste
 points' mechanical state (position, velocity, affine velocity, deformation gradient, strains,
 stresses, J) is extrapolated; the heat, the phase and everything else are those of the two
 halves (the heat step is first order, or explicit substeps whose error the halves only shrink);
-the equivalent plastic strain never falls below the step's start.
+the equivalent plastic strain never falls below the step's start. Where the two solutions of a
+point disagree so much that its extrapolated J would fall below half the halves' J, that point
+keeps the halves' state (first order there; counted in ``kept``).
 """
 
 import taichi as ti
@@ -40,15 +42,22 @@ EXTRAPOLATED = (
 
 
 @ti.kernel
-def extrapolate(now: ti.template(), whole: ti.template(), start: ti.template()):
-    """now = 2 now - whole on the mechanical members; the equivalent plastic strain too, kept
-    at or above ``start``'s."""
+def extrapolate(now: ti.template(), whole: ti.template(), start: ti.template()) -> ti.i32:
+    """now = 2 now - whole on the mechanical members (the equivalent plastic strain kept at or
+    above ``start``'s). A point whose extrapolated J would fall below half its J after the
+    halves (the two solutions disagree by more than a step can be trusted to extrapolate)
+    keeps the halves' state; returns how many did."""
+    kept = 0
     for p in now:
-        for name in ti.static(EXTRAPOLATED):
-            field, other = ti.static(getattr(now, name), getattr(whole, name))
-            field[p] = 2.0 * field[p] - other[p]
-        e = 2.0 * now[p].equivalent_plastic_strain - whole[p].equivalent_plastic_strain
-        now[p].equivalent_plastic_strain = ti.max(e, start[p].equivalent_plastic_strain)
+        if 2.0 * now[p].J - whole[p].J < 0.5 * now[p].J:
+            kept += 1
+        else:
+            for name in ti.static(EXTRAPOLATED):
+                field, other = ti.static(getattr(now, name), getattr(whole, name))
+                field[p] = 2.0 * field[p] - other[p]
+            e = 2.0 * now[p].equivalent_plastic_strain - whole[p].equivalent_plastic_strain
+            now[p].equivalent_plastic_strain = ti.max(e, start[p].equivalent_plastic_strain)
+    return kept
 
 
 class ExtrapolatedStepper:
@@ -64,6 +73,7 @@ class ExtrapolatedStepper:
         n = self.st.n_points
         self.start = kind.field(shape=n, layout=ti.Layout.SOA)
         self.whole = kind.field(shape=n, layout=ti.Layout.SOA)
+        self.kept = 0  # points that kept the halves' state, over the run
 
     @property
     def last(self):
@@ -96,6 +106,6 @@ class ExtrapolatedStepper:
             self.inner.step()
         finally:
             sc.dt[None], sc.dt_heat[None] = dt, dt_heat
-        extrapolate(st.points, self.whole, self.start)
+        self.kept += extrapolate(st.points, self.whole, self.start)
         sc.step[None] = int(before["steps"]) + 1
         init_box(st)

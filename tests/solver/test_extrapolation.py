@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from taichi_sls.solver import checkpoint
-from taichi_sls.solver.extrapolation import ExtrapolatedStepper
+from taichi_sls.solver.adaptive import copy_points
+from taichi_sls.solver.extrapolation import ExtrapolatedStepper, extrapolate
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.solver.step import init_box
 from taichi_sls.solver.time_step import time_step_limits
@@ -64,6 +65,27 @@ def test_extrapolated_step_is_second_order_on_a_spinning_disc():
     assert abs(be[0] / be[1]) < 3.0
     assert abs(ex[0] / ex[1]) > 3.0
     assert abs(ex[1]) < 0.1 * abs(be[1])
+
+
+def test_a_point_whose_two_solutions_disagree_keeps_the_halves():
+    """Where a point's extrapolated J would fall below half its J after the halves, the point
+    keeps the halves' state (all of it) and is counted; a point whose solutions agree is
+    extrapolated, 2 J_halves - J_whole."""
+    time_ = {"integrator": "implicit", "implicit_scheme": "extrapolated"}
+    sim = Simulation(ver.load("laplace", 10, {"time": time_}).case)
+    stepper, pt = sim.implicit, sim.state.points
+    copy_points(pt, stepper.whole)
+    copy_points(pt, stepper.start)
+    J = pt.J.to_numpy()
+    whole = J.copy()
+    whole[0] *= 3.0  # extrapolated: -J, refused
+    whole[1] *= 1.1  # extrapolated: 0.9 J
+    stepper.whole.J.from_numpy(whole)
+    assert extrapolate(pt, stepper.whole, stepper.start) == 1
+    after = pt.J.to_numpy()
+    assert after[0] == J[0]
+    assert after[1] == pytest.approx(0.9 * J[1], rel=1e-12)
+    np.testing.assert_array_equal(after[2:], J[2:])
 
 
 def test_extrapolated_step_under_the_adaptive_step():
