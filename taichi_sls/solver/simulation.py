@@ -217,6 +217,9 @@ class Simulation(NeckMeasures):
             if self.handover.explicit:
                 n -= self._explicit_steps(n)
                 continue
+            if self.adaptive.dt < self.adaptive.handback_below:  # hands back before a load
+                self.handover.hand_back(self.t)
+                continue
             if self.before_step is not None:
                 self.before_step(self)
             if self.adaptive.step():
