@@ -276,6 +276,7 @@ def run_case(
             refused_steps=sim.adaptive.refused if sim.adaptive is not None else 0,
             handover_s=sim.handover.at_s if sim.handover is not None else None,
             handbacks=sim.handover.handbacks if sim.handover is not None else 0,
+            extrapolation_kept_points=getattr(sim.implicit, "kept", 0),
             T_peak_C=last.get("T_peak_C"),
             warnings=list(dict.fromkeys(warnings)),
         )

@@ -15,7 +15,8 @@ stresses, J) is extrapolated; the heat, the phase and everything else are those 
 halves (the heat step is first order, or explicit substeps whose error the halves only shrink);
 the equivalent plastic strain never falls below the step's start. Where the two solutions of a
 point disagree so much that its extrapolated J would fall below half the halves' J, that point
-keeps the halves' state (first order there; counted in ``kept``).
+keeps the halves' state (first order there; counted in ``kept``, the main job's summary
+``extrapolation_kept_points``).
 """
 
 import taichi as ti
@@ -23,7 +24,7 @@ import taichi as ti
 from . import checkpoint
 from .adaptive import copy_points
 from .fields import POINT_MEMBERS, struct_type
-from .implicit import ImplicitStepper
+from .implicit import ImplicitStepper, StepReport
 from .step import init_box
 
 # the points' members the extrapolation combines: the mechanics a step integrates
@@ -76,7 +77,7 @@ class ExtrapolatedStepper:
         self.kept = 0  # points that kept the halves' state, over the run
 
     @property
-    def last(self):
+    def last(self) -> StepReport:
         return self.inner.last
 
     @property
@@ -85,6 +86,7 @@ class ExtrapolatedStepper:
 
     def compile(self) -> None:
         self.inner.compile(self)
+        self.kept = 0
 
     def advance(self, n: int) -> None:
         for _ in range(n):
