@@ -160,7 +160,7 @@ class AdaptiveStepper:
         take it)."""
         st = self.st
         while True:
-            if self.dt < self.handback_below:
+            if self.hands_back():
                 return False
             t = float(st.scalars.t[None])
             dt = self._limit(t, t_end)
@@ -186,6 +186,11 @@ class AdaptiveStepper:
             if not (cut and ratio <= 1.0):
                 self.dt = next_step(dt, ratio, self.controls)
             return True
+
+    def hands_back(self) -> bool:
+        """Whether the next step would be shorter than ``handback_below`` (the hybrid's
+        explicit steps take it)."""
+        return self.dt < self.handback_below
 
     def _redo(self, before: dict[str, np.ndarray], dt: float, smaller: float, why: str) -> None:
         """Put the state back and make the next try ``smaller``; below dt_min, give up."""

@@ -217,7 +217,7 @@ class Simulation(NeckMeasures):
             if self.handover.explicit:
                 n -= self._explicit_steps(n)
                 continue
-            if self.adaptive.dt < self.adaptive.handback_below:  # hands back before a load
+            if self.adaptive.hands_back():  # before the study's load, not after it
                 self.handover.hand_back(self.t)
                 continue
             if self.before_step is not None:
