@@ -8,7 +8,9 @@ Runs each bundled case (default power5W, power15W, power25W, nolaser) at each gr
 h = 2 um, scaled with the elastic limit, as ``bench accuracy --paper``), and at the spacing
 ``--at`` (2 um) also with dt times each ``--dt-factors`` (1/2, 1/4). ``--refrozen`` runs
 h = 4, 2, 1 um until the pair has refrozen (``time.stop = "solidified"``) into
-out/refinement_refrozen. ``--set`` overrides every run's case (after the study's own keys).
+out/refinement_refrozen. ``--set`` overrides every run's case (after the study's own keys);
+where it sets ``time.dt_s=auto`` a dt factor scales ``time.safety`` instead, and the accuracy
+controls of an adaptive (or hybrid) implicit step with it.
 
 Each run writes its usual outputs to OUT/<case>/h<h>um_dt<factor>/; a run already finished there
 (complete, or stopped by the guard, with the same resolved case.toml) is read, not run again, so
@@ -130,6 +132,23 @@ def _row(case: str, h: float, f: float, stop: str, folder: Path, s: dict) -> dic
     }
 
 
+def _step_scaling(c: Any, f: float) -> list[str]:
+    """Overrides that scale the step by ``f`` where the case chooses it itself: with
+    ``time.dt_s = "auto"`` the safety fraction of the stability limit, and where an adaptive
+    implicit step follows (``time.adaptive``, the hybrid) its accuracy controls too, so that a dt
+    factor still refines every step of the run."""
+    t = c.time
+    if t.dt_s != "auto":
+        return []
+    keys = [f"time.safety={t.safety * f:.6g}"]
+    if t.adaptive or t.integrator == "hybrid":
+        keys += [
+            f"time.{k}={getattr(t, k) * f:.6g}"
+            for k in ("max_temperature_change_K", "max_motion_cells", "max_strain_increment")
+        ]
+    return keys
+
+
 def run_one(
     case: str, h: float, f: float, out: Path, refrozen: bool, sets: list[str]
 ) -> dict[str, Any]:
@@ -144,6 +163,8 @@ def run_one(
     own += ["output.png=false", "output.gif=false"]  # the frames would cost more than the steps
     try:
         c = load_case(case, [*own, *sets])
+        if f != 1.0:  # a --set time.dt_s=auto replaced the study's dt: scale what sets the step
+            c = load_case(case, [*own, *sets, *_step_scaling(c, f)])
         s = complete_summary(folder, DONE)
         toml = folder / "case.toml"
         if s is not None and (not toml.is_file() or toml.read_text() != case_to_toml(c)):

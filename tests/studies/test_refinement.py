@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from taichi_sls.studies.refinement import COLUMNS, plan
+from taichi_sls.config import load_case
+from taichi_sls.studies.refinement import COLUMNS, _step_scaling, plan
 from taichi_sls.studies.refinement_report import plot, read_csv, rel_change, richardson, write_table
 
 
@@ -144,3 +145,19 @@ def test_refinement_study_end_to_end(tmp_path):
     before = (tmp_path / "power25W_coarse" / "h8um_dt1" / "summary.json").stat().st_mtime_ns
     assert main(args) == 0
     assert (tmp_path / "power25W_coarse" / "h8um_dt1" / "summary.json").stat().st_mtime_ns == before
+
+
+def test_a_dt_factor_scales_a_step_the_case_chooses_itself():
+    # the study sets time.dt_s per h; a --set time.dt_s=auto after it would leave a dt factor
+    # without effect (the "dt/2" run the same as dt's): the factor moves to what sets the step
+    fixed = load_case("power25W", ["time.dt_s=5e-8"])
+    assert _step_scaling(fixed, 0.5) == []
+    explicit = load_case("power25W", ["time.dt_s=auto"])
+    assert _step_scaling(explicit, 0.5) == [f"time.safety={explicit.time.safety * 0.5:.6g}"]
+    hybrid = load_case("power25W", ["time.dt_s=auto", "time.integrator=hybrid"])
+    halved = load_case("power25W", ["time.dt_s=auto", *_step_scaling(hybrid, 0.5)])
+    t, h = hybrid.time, halved.time
+    assert h.safety == pytest.approx(t.safety / 2)
+    assert h.max_temperature_change_K == pytest.approx(t.max_temperature_change_K / 2)
+    assert h.max_motion_cells == pytest.approx(t.max_motion_cells / 2)
+    assert h.max_strain_increment == pytest.approx(t.max_strain_increment / 2)
