@@ -29,7 +29,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..config import CaseError, case_to_toml, load_case
+from ..config import Case, CaseError, case_to_toml, load_case
 from ..config.loading import add_set_argument
 from .refinement_report import num, plot, read_csv, write_table
 
@@ -132,16 +132,16 @@ def _row(case: str, h: float, f: float, stop: str, folder: Path, s: dict) -> dic
     }
 
 
-def _step_scaling(c: Any, f: float) -> list[str]:
+def _step_scaling(c: Case, f: float) -> list[str]:
     """Overrides that scale the step by ``f`` where the case chooses it itself: with
     ``time.dt_s = "auto"`` the safety fraction of the stability limit, and where an adaptive
-    implicit step follows (``time.adaptive``, the hybrid) its accuracy controls too, so that a dt
-    factor still refines every step of the run."""
+    implicit step follows (``Case.step_adapts``) its accuracy controls too, so that a dt factor
+    still refines every step of the run."""
     t = c.time
     if t.dt_s != "auto":
         return []
     keys = [f"time.safety={t.safety * f:.6g}"]
-    if t.adaptive or t.integrator == "hybrid":
+    if c.step_adapts():
         keys += [
             f"time.{k}={getattr(t, k) * f:.6g}"
             for k in ("max_temperature_change_K", "max_motion_cells", "max_strain_increment")
