@@ -55,6 +55,14 @@ class Time(Model):
         description="settled: kinetic energy (with the inertia scale) below this fraction of "
         "gamma times the bodies' perimeter",
     )
+    settled_neck_change: float = Field(
+        1e-3,
+        gt=0,
+        description="settled, for a case no laser heats (solid from the start, so only its "
+        "motion can end the run): the kinetic energy has stayed below "
+        "settled_kinetic_fraction, and the first contact's neck within this fraction of its "
+        "last value, over the three frames before the last (jobs/schedule.py)",
+    )
     safety: float = Field(0.4, gt=0, description='fraction of the stability limit for "auto"')
     allow_unstable_dt: bool = Field(False, description="let a fixed dt exceed the stability limit")
     heat_every: AutoCount = Field(

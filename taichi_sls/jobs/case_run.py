@@ -16,6 +16,7 @@ import json
 import math
 import sys
 import time
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -35,7 +36,7 @@ from ..solver.simulation import Simulation
 from .bed_outcome import ContactHistory, bed_summary, describe_bed, is_bed
 from .outcome import NeckHistory, describe, neck_region, outcome
 from .progress import Progress
-from .schedule import frame_steps, settled
+from .schedule import SETTLED_FRAMES, frame_steps, settled
 from .unheated import needs_baseline, unheated_neck_um
 
 # statuses: complete (end_s reached, or solidified and settled), max_time (stop = solidified
@@ -174,7 +175,7 @@ def run_case(
     else:
         first = frame(0)
     summary["initial"] = first
-    last = first
+    last, before = first, deque(maxlen=SETTLED_FRAMES)  # the frames before last
     walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
     bar = Progress(
         horizon,
@@ -206,6 +207,7 @@ def run_case(
                 step_wall += time.perf_counter() - t0
                 pace = (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0
                 bar.update(sim.t, pace, sim.step_dt)
+            before.append(last)
             last = frame(k)
             bar.note(last)
             if checkpoint_every and k % checkpoint_every == 0:
@@ -216,11 +218,11 @@ def run_case(
                     "surface energy with solver.mass_scale = "
                     f"{case.solver.mass_scale:g}: inertia matters, the scale is too large"
                 )
-            if solidify and settled(last, case, sim.t):
+            if solidify and settled(last, case, sim.t, before):
                 break
         solid = last["molten_fraction"] == 0.0
         summary["status"] = (
-            "max_time" if solidify and not settled(last, case, sim.t) else "complete"
+            "max_time" if solidify and not settled(last, case, sim.t, before) else "complete"
         )
     except SimulationError as e:
         summary["status"] = "failed"

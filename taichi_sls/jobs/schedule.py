@@ -9,7 +9,7 @@ put the whole transient between the first two frames and rows."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 from ..config import Case
 from .outcome import laser_acted
@@ -53,13 +53,36 @@ def frame_steps(case: Case, dt: float) -> Iterator[int]:
         k += 1
 
 
-def settled(mon: dict[str, float], case: Case, t: float) -> bool:
+SETTLED_FRAMES = 3  # frames before the last that an unheated case's neck must agree with
+
+
+def settled(
+    mon: dict[str, float], case: Case, t: float, before: Sequence[dict[str, float]] = ()
+) -> bool:
     """The stop rule of ``time.stop = "solidified"``: every laser is off, every point solid and
     the kinetic energy (with the inertia scale) below ``settled_kinetic_fraction`` of the
-    surface energy."""
-    return (
-        t >= case.lasers_off_s()
-        and mon["molten_fraction"] == 0.0
-        and mon["T_max_C"] <= min(m.crystallization_C for m in case.materials.values())
-        and mon.get("kinetic_ratio", 0.0) < case.time.settled_kinetic_fraction
-    )
+    surface energy. A case no laser heats is solid from the start, and the kinetic energy of
+    its first adhesive contact swings through that fraction while the neck still moves by
+    percents (two frames may even catch the swing at one neck), so there the kinetic energy must
+    have stayed below it, and the first contact's neck within ``settled_neck_change`` of the
+    last, over the ``SETTLED_FRAMES`` frames ``before`` the last (a doubling of the time at ten
+    frames a decade)."""
+
+    def quiet(m: dict[str, float]) -> bool:
+        return (
+            t >= case.lasers_off_s()
+            and m["molten_fraction"] == 0.0
+            and m["T_max_C"] <= min(mat.crystallization_C for mat in case.materials.values())
+            and m.get("kinetic_ratio", 0.0) < case.time.settled_kinetic_fraction
+        )
+
+    if not quiet(mon) or laser_acted(case):
+        return quiet(mon)
+    recent = list(before)[-SETTLED_FRAMES:]
+    if len(recent) < SETTLED_FRAMES or not all(quiet(m) for m in recent):
+        return False
+    neck = mon.get("contact_line_um", math.nan)
+    if not math.isfinite(neck):
+        return True  # no contact to follow: the kinetic energy decides
+    tol = case.time.settled_neck_change * neck
+    return all(abs(m.get("contact_line_um", math.nan) - neck) <= tol for m in recent)

@@ -62,6 +62,27 @@ def test_settled_needs_lasers_off_solid_and_quiet():
     assert not settled({**quiet, "kinetic_ratio": 1e-2}, case, 3e-5)
 
 
+def test_an_unheated_case_settles_only_once_its_neck_stops_moving():
+    """Without a laser the pair is solid from t = 0 and its kinetic energy swings through the
+    threshold while the adhesive contact still moves (the 4 um fillet pair at h = 4 um: two
+    frames at 25 and 32 us caught the swing at one neck, 20.353 and 20.362 um, with 8.7e-5 of
+    the surface energy)."""
+    case = _case({"lasers": [], "time": {"stop": "solidified"}})
+    quiet = {"molten_fraction": 0.0, "T_max_C": 140.0, "kinetic_ratio": 8.7e-5}
+    last = {**quiet, "contact_line_um": 20.362}
+    loud = {**quiet, "kinetic_ratio": 1.7e-4}
+    swing = [{**loud, "contact_line_um": 20.236}, {**quiet, "contact_line_um": 20.353}]
+    assert not settled(last, case, 3.2e-5)  # no frames before to compare with
+    assert not settled(last, case, 3.2e-5, [{**loud, "contact_line_um": 20.40}, *swing])
+    held = [{**quiet, "contact_line_um": n} for n in (20.350, 20.355, 20.360)]
+    assert settled(last, case, 3.2e-5, held)
+    assert not settled(last, case, 3.2e-5, [*held[:2], {**held[2], "contact_line_um": 20.0}])
+    assert not settled({**last, "kinetic_ratio": 1e-3}, case, 3.2e-5, held)
+    # a heated case is judged at refreezing as before: its creeping neck does not hold it
+    heated = _case({"lasers": [{"power_W": 25.0, "off_s": 2e-5}], "time": {"stop": "solidified"}})
+    assert settled({**last, "T_max_C": 145.0}, heated, 3e-5, swing)
+
+
 def _history(necks, molten, times):
     h = NeckHistory()
     for n, m, t in zip(necks, molten, times, strict=True):

@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 
 from taichi_sls.cli import main as cli_main
-from taichi_sls.config import bundled_case
+from taichi_sls.config import bundled_case, load_case
+from taichi_sls.studies.sweep.plots import neck_growth
 from taichi_sls.studies.sweep.results import read_results
 from taichi_sls.studies.sweep.runner import run_sweep
 from taichi_sls.studies.sweep.spec import case_id, load_sweep
@@ -66,6 +67,14 @@ def test_sweep_file_grid_bundles_and_ids():
     assert "lasers.0.x_end_um=80.0" in scan.overrides
     assert case_id("b", ["x=1", "y=2"]) == case_id("b", ["y=2", "x=1"])
     assert case_id("b", ["x=1"]) != case_id("b", ["x=2"])
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "sweeps").glob("*.toml")), ids=lambda p: p.stem)
+def test_every_bundled_sweep_case_loads(path):
+    """A sweep file whose case a key or value refuses would fail one worker per case, minutes in."""
+    sweep = load_sweep(path)
+    for c in sweep.cases:
+        load_case(str(sweep.base), c.overrides)
 
 
 def test_three_cases_give_three_rows(first_sweep):
@@ -160,3 +169,16 @@ def test_sweep_on_existing_scheduler(tmp_path):
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait()
+
+
+def test_the_process_map_measures_growth_against_the_verdicts_baseline():
+    """Where the rows collected the unheated pair's neck (the default verdict's reference), the
+    map colours the growth over it; a row set without it keeps the growth over the start."""
+    rows = [
+        {"contact0_um": 18.6, "neck_final_um": 19.2, "neck_unheated_um": 19.6},
+        {"contact0_um": 18.6, "neck_final_um": 21.0, "neck_unheated_um": 19.6},
+    ]
+    growth, reference = neck_growth(rows, "neck_final_um")
+    assert reference == "unheated" and growth == pytest.approx([-0.4, 1.4])
+    growth, reference = neck_growth([{**rows[0], "neck_unheated_um": ""}, rows[1]], "neck_final_um")
+    assert reference == "initial" and growth == pytest.approx([0.6, 2.4])

@@ -6,8 +6,9 @@
 - :func:`plot_radius_scan`: Fig. 8, the same against spot radius (stationary rows at the most
   common power) and stationary against scanning beams at that power and 50 um, as bars;
 - :func:`plot_process_map`: laser power (y) against scan speed or spot radius (x), coloured by
-  the final neck's growth over the initial one, the verdict of each run marked (o fused, x not,
-  ? undecided), the melt line T_peak = T_m drawn as a contour.
+  the final neck's growth over the unheated pair's neck where the rows collected it
+  (``neck_unheated_um``, the verdict's baseline), else over the initial one, the verdict of
+  each run marked (o fused, x not, ? undecided), the melt line T_peak = T_m drawn as a contour.
 
 Each row's laser power, spot radius and speed, and its initial contact line, come from the case's
 own outputs (``OUT/<id>/case.toml``, ``OUT/<id>/summary.json``); without them, from the row's
@@ -175,6 +176,15 @@ def plot_radius_scan(results_csv: str | Path, png: str | Path) -> Path:
     return _save(fig, png)
 
 
+def neck_growth(rows: list[dict[str, Any]], neck: str) -> tuple[list[float], str]:
+    """Each row's ``neck`` (um) over the neck its verdict was judged by: the unheated pair's
+    (``neck_unheated_um``) where every row collected one, else the initial contact line; and
+    which of the two it was."""
+    unheated = bool(rows) and all(np.isfinite(_num(r, "neck_unheated_um")) for r in rows)
+    base = "neck_unheated_um" if unheated else "contact0_um"
+    return [_num(r, neck) - _num(r, base) for r in rows], "unheated" if unheated else "initial"
+
+
 def plot_process_map(results_csv: str | Path, png: str | Path, xkey: str = "v_m_s") -> Path:
     """Power (y) against scan speed (``xkey = "v_m_s"``) or spot radius (``"r0_um"``), coloured
     by the final neck's growth; the verdicts marked; the melt line T_peak = T_m as a contour."""
@@ -195,14 +205,14 @@ def plot_process_map(results_csv: str | Path, png: str | Path, xkey: str = "v_m_
     growth = np.full((len(powers), len(xs)), np.nan)
     tpeak = np.full_like(growth, np.nan)
     verdicts = []
-    neck = (
-        "neck_final_um"
-        if any(r.get("neck_final_um") not in (None, "") for r in rows)
-        else ("contact_line_um")
+    kept = ("neck_final_um", "neck_refrozen_um")  # what the part keeps, where collected
+    neck = next(
+        (k for k in kept if any(r.get(k) not in (None, "") for r in rows)), "contact_line_um"
     )
-    for r in rows:
+    grown, reference = neck_growth(rows, neck)
+    for r, g in zip(rows, grown, strict=True):
         i, j = powers.index(r["P_W"]), xs.index(r[xkey])
-        growth[i, j] = _num(r, neck) - r["contact0_um"]
+        growth[i, j] = g
         tpeak[i, j] = _num(r, "T_peak_C")
         fused = r.get("fused")
         mark = {True: "o", False: "x", "True": "o", "False": "x"}.get(fused, "?")
@@ -216,7 +226,7 @@ def plot_process_map(results_csv: str | Path, png: str | Path, xkey: str = "v_m_
     # the x values as equally spaced columns labelled with their values
     X, Y = np.meshgrid(np.arange(len(xs)), powers)
     mesh = ax.pcolormesh(X, Y, growth, shading="nearest", **scale)
-    fig.colorbar(mesh, ax=ax, label="neck growth, final - initial [um]")
+    fig.colorbar(mesh, ax=ax, label=f"neck growth, final - {reference} [um]")
     for j, P, mark in verdicts:
         i = powers.index(P)
         text = f"{growth[i, j]:+.1f}" if np.isfinite(growth[i, j]) else ""
@@ -235,7 +245,7 @@ def plot_process_map(results_csv: str | Path, png: str | Path, xkey: str = "v_m_
     ax.set(xlabel=xlabel, ylabel="laser power [W]")
     ax.set_title(
         "Neck kept after refreezing (o fused, x not, ? undecided, ! failed)"
-        if neck == "neck_final_um"
+        if neck in kept
         else "Contact-line growth over the run",
         fontsize=9,
     )
