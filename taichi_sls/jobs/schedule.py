@@ -76,8 +76,9 @@ def settled(
             and m.get("kinetic_ratio", 0.0) < case.time.settled_kinetic_fraction
         )
 
-    if not quiet(mon) or laser_acted(case):
-        return quiet(mon)
+    now = quiet(mon)
+    if not now or laser_acted(case):
+        return now
     recent = list(before)[-SETTLED_FRAMES:]
     if len(recent) < SETTLED_FRAMES or not all(quiet(m) for m in recent):
         return False
