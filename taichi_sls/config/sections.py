@@ -138,6 +138,17 @@ class Contact(Model):
         "and lowers it: the 25 W point-contact case reads 15.7 um at 1 ms where the column reads "
         "21.6; docs/convergence.md)",
     )
+    settle: bool = Field(
+        False,
+        description="true: the run starts from the bodies' own adhesive equilibrium at their "
+        "initial temperature: before t = 0 they step with every laser absorbing nothing until "
+        "the settle rule of a case no laser heats holds (time.settled_kinetic_fraction, "
+        "time.settled_neck_change, checked on the output's log-spaced frame times, at most "
+        "time.max_s), then the clock, the points' start positions and the integrator begin "
+        "again there and the lasers act on their own times. The settled neck is the verdict's "
+        "unheated baseline (no separate run). false: the laser meets the bodies as seeded "
+        "(jobs/settle.py; docs/convergence.md)",
+    )
 
 
 class Thermal(Model):

@@ -36,7 +36,8 @@ from ..solver.simulation import Simulation
 from .bed_outcome import ContactHistory, bed_summary, describe_bed, is_bed
 from .outcome import NeckHistory, describe, neck_region, outcome
 from .progress import Progress
-from .schedule import SETTLED_FRAMES, frame_steps, settled
+from .schedule import SETTLED_FRAMES, frame_steps, reached, settled, step_towards
+from .settle import settle
 from .unheated import needs_baseline, unheated_neck_um
 
 # statuses: complete (end_s reached, or solidified and settled), max_time (stop = solidified
@@ -95,7 +96,7 @@ def run_case(
     out_dir = Path(out_dir)
     wall0 = time.perf_counter()
     baseline_um = None
-    if needs_baseline(case) and scene is None:
+    if needs_baseline(case) and scene is None and not case.contact.settle:
         print(
             f"{case.case.name}: the unheated baseline ({case.fusion.baseline_s:g} s without "
             "laser heat)",
@@ -172,8 +173,20 @@ def run_case(
                 },
             )
         print(f"resumed from {resume} at frame {k0}, t = {sim.t:.6g} s", file=sys.stderr)
+        if "settle" in old:
+            summary["settle"] = old["settle"]
     else:
+        if case.contact.settle:
+            try:
+                summary["settle"] = settle(sim, case, progress)
+            except SimulationError as e:  # never settled, or the guard stopped it
+                summary.update(status="failed", error=str(e), wall_s=time.perf_counter() - wall0)
+                writer.summary(summary)
+                writer.finish()
+                return summary
         first = frame(0)
+    if "settle" in summary and needs_baseline(case):  # the settled pair is the unheated one
+        baseline_um = summary["settle"]["neck_um"]
     summary["initial"] = first
     last, before = first, deque(maxlen=SETTLED_FRAMES)  # the frames before last
     walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
@@ -189,21 +202,12 @@ def run_case(
     step_wall = 0.0
     steps0 = sim.steps
 
-    def reached(frame_step: int) -> bool:
-        """Whether the run has reached a frame's step (its time, with the adaptive step)."""
-        if sim.adaptive is None:
-            return sim.steps >= frame_step
-        return sim.t >= frame_step * sim.dt * (1.0 - 1e-12)
-
     solid = False
     try:
         for k in range(k0 + 1, len(schedule) + 1):
-            while not reached(schedule[k - 1]):
+            while not reached(sim, schedule[k - 1]):
                 t0 = time.perf_counter()
-                if sim.adaptive is not None:  # steps of its own size, landing on the frame
-                    sim.advance_to(schedule[k - 1] * sim.dt)
-                else:
-                    sim.advance(min(2000, schedule[k - 1] - sim.steps))
+                step_towards(sim, schedule[k - 1])
                 step_wall += time.perf_counter() - t0
                 pace = (sim.steps - steps0) / step_wall if step_wall > 0 else 0.0
                 bar.update(sim.t, pace, sim.step_dt)

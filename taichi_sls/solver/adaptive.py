@@ -124,6 +124,7 @@ class AdaptiveStepper:
         self.implicit = implicit
         self.controls = StepControls.from_case(case, dt0, floor)
         self.dt = min(self.controls.dt_max, max(self.controls.dt_min, dt0))  # the next to try
+        self.first_dt = self.dt  # the first, tried again when the clock restarts
         self.heat_step_max = heat_step_max
         self.edges = laser_switch_times(case)
         self.last_dt = self.dt  # the last step taken

@@ -128,6 +128,15 @@ class Handover:
         self.handbacks += 1
         self.restart_stretch(t)
 
+    def start_again(self, t: float) -> None:
+        """The explicit phase begins again at t, as at the start of a run (contact.settle: the
+        clock restarts at the settled state)."""
+        if not self.explicit:
+            self.hand_back(t)
+        self.handbacks, self.at_s = 0, math.nan
+        self.adaptive.dt = self.adaptive.first_dt
+        self.restart_stretch(t)
+
     def restart_stretch(self, t: float) -> None:
         """A stretch of explicit steps begins at t; after a hand-back its starting points are
         kept for its check (before the first hand-over the kinetic rule needs none)."""

@@ -195,6 +195,18 @@ class Simulation(NeckMeasures):
             if self.t < t * (1.0 - 1e-12):  # stopped short: the explicit steps take over
                 self.handover.hand_back(self.t)
 
+    def restart_clock(self) -> None:
+        """t = 0 at the state reached (contact.settle): the step count, the points' start
+        positions and the integrator's phase begin again here (the heat clock keeps its phase:
+        an explicit heat step's strain increment may be under way)."""
+        self.state.scalars.t[None] = 0.0
+        self.steps = 0
+        self.state.points.x0.copy_from(self.state.points.x)
+        if self.handover is not None:
+            self.handover.start_again(0.0)
+        elif self.adaptive is not None:
+            self.adaptive.dt = self.adaptive.first_dt
+
     def kinetic_ratio(self, kinetic_energy: float | None = None) -> float:
         """The kinetic energy (times the inertia scale; default: the points' now) over the
         surface energy."""
