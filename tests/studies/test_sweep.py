@@ -182,3 +182,21 @@ def test_the_process_map_measures_growth_against_the_verdicts_baseline():
     assert reference == "unheated" and growth == pytest.approx([-0.4, 1.4])
     growth, reference = neck_growth([{**rows[0], "neck_unheated_um": ""}, rows[1]], "neck_final_um")
     assert reference == "initial" and growth == pytest.approx([0.6, 2.4])
+
+
+def test_plot_only_draws_a_results_table_without_its_run_folders(tmp_path):
+    """--plot-only on a results.csv copied away from its runs: the spot radius is then unknown
+    (it comes from each run's case.toml), and every figure is still drawn."""
+    from taichi_sls.studies.sweep.draw import draw_all
+
+    rows = [(P, v) for P in (5, 25) for v in (0.0, 1.0)]
+    with (tmp_path / "results.csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(
+            ["id", "lasers.0.power_W", "lasers.0.speed_m_s", "T_peak_C", "neck_1ms_um",
+             "neck_final_um", "neck_unheated_um", "status"]
+        )  # fmt: skip
+        for k, (P, v) in enumerate(rows):
+            w.writerow([f"c{k}", P, v, 160 + 6 * P, 19.5, 19.6 + P / 100, 19.64, "complete"])
+    drawn = {p.name for p in draw_all(tmp_path)}
+    assert drawn == {"fig5_power.png", "fig8_radius_scan.png", "process_map.png"}

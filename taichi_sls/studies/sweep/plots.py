@@ -168,7 +168,8 @@ def plot_radius_scan(results_csv: str | Path, png: str | Path) -> Path:
             ax.bar(i, v, color=color, alpha=0.8 if not h else 0.4, hatch=h)
             ax.text(i, v, f"{v:.3g}", ha="center", va="bottom", fontsize=8)
         ax.set_xticks(range(len(bars)), labels)
-        ax.set(ylabel=ylabel, title=f"stationary vs scanning, {P:g} W, r0 = {r0:g} um")
+        spot = f", r0 = {r0:g} um" if r0 is not None else ""  # unknown without the run folders
+        ax.set(ylabel=ylabel, title=f"stationary vs scanning, {P:g} W{spot}")
         if key == "T_peak_C":
             ax.axhline(bars[0]["melt_C"], color="0.5", ls="--", lw=1)
             ax.set_ylim(bottom=min(140.0, min(vals) - 10))
