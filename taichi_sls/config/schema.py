@@ -255,6 +255,12 @@ class Case(Model):
                 f"solver.update = {self.solver.update!r}: the implicit integrator moves the "
                 'points with its converged grid velocity (allowed with it: "usl")'
             )
+        if self.contact.settle_steps == "implicit" and not self.implicit_mechanics():
+            raise CaseError(
+                f'contact.settle_steps = "implicit" with time.integrator = '
+                f"{self.time.integrator!r}: settling by implicit steps needs them (allowed: "
+                'time.integrator = "hybrid" or "implicit", or settle_steps = "explicit")'
+            )
         if self.time.adaptive and not self.implicit_mechanics():
             raise CaseError(
                 f"time.adaptive = true with time.integrator = {self.time.integrator!r}"

@@ -149,6 +149,13 @@ class Contact(Model):
         "unheated baseline (no separate run). false: the laser meets the bodies as seeded "
         "(jobs/settle.py; docs/convergence.md)",
     )
+    settle_steps: Literal["explicit", "implicit"] = Field(
+        "explicit",
+        description="settle: the steps that settle the bodies. explicit: the case's own (the "
+        "hybrid's explicit steps until its hand-over rule holds); implicit: the adaptive "
+        "implicit step from the start (backward Euler damps the ringing instead of stepping "
+        "through it; needs time.integrator = hybrid or implicit; docs/convergence.md)",
+    )
 
 
 class Thermal(Model):

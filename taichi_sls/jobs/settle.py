@@ -53,6 +53,8 @@ def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, floa
     rule = settle_rule_case(case)
     wall0 = time.perf_counter()
     lasers_absorb(sim, False)
+    if case.contact.settle_steps == "implicit" and sim.handover is not None:
+        sim.handover.hand_over(sim.t)  # adaptive implicit steps from the start
     last = sim.monitors()
     before: deque[dict[str, float]] = deque(maxlen=SETTLED_FRAMES)
     done = False

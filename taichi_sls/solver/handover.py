@@ -111,6 +111,11 @@ class Handover:
             if proposed < self.adaptive.handback_below:
                 return
             self.adaptive.dt = proposed
+        self.hand_over(t)
+
+    def hand_over(self, t: float) -> None:
+        """The implicit step takes over at t (the rule's, or contact.settle_steps = "implicit"
+        from the start)."""
         self.adaptive.st.points.iso_strain_step.fill(0.0)
         self.explicit = False
         if self.handbacks == 0:
