@@ -139,7 +139,6 @@ class Handover:
         if not self.explicit:
             self.hand_back(t)
         self.handbacks, self.at_s = 0, math.nan
-        self.adaptive.dt = self.adaptive.first_dt
         self.restart_stretch(t)
 
     def restart_stretch(self, t: float) -> None:

@@ -202,10 +202,10 @@ class Simulation(NeckMeasures):
         self.state.scalars.t[None] = 0.0
         self.steps = 0
         self.state.points.x0.copy_from(self.state.points.x)
+        if self.adaptive is not None:
+            self.adaptive.dt = self.adaptive.first_dt
         if self.handover is not None:
             self.handover.start_again(0.0)
-        elif self.adaptive is not None:
-            self.adaptive.dt = self.adaptive.first_dt
 
     def kinetic_ratio(self, kinetic_energy: float | None = None) -> float:
         """The kinetic energy (times the inertia scale; default: the points' now) over the
