@@ -72,6 +72,13 @@ class BlockPlan:
         self.sorts = 0  # how often the points were sorted again during the run
         self.box.fill(0)
         self.box.from_numpy(np.tile(np.array([nx, ny, 0, 0], dtype=np.int32), (self.n_blocks, 1)))
+        self.clear_sums()
+
+    def clear_sums(self) -> None:
+        """No step's energy or peak in the per-block accumulators (at the start, and where a
+        state is put back: a refused step's sums would reach the totals at the next reduction)."""
+        self.laser_energy.fill(0.0)
+        self.heat_out.fill(0.0)
         self.T_peak.fill(-1e30)
 
     def order(self, x: np.ndarray) -> np.ndarray:

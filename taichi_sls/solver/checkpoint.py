@@ -105,9 +105,11 @@ def restore(st: State, data: Mapping[str, np.ndarray]) -> None:
         getattr(st.scalars, k)[None] = float(data[f"s_{k}"])
     for k in NODE_MEMBERS:
         getattr(st.nodes, k).from_numpy(data[f"g_{k}"])
-    if st.blocks is not None and "b_start" in data:
-        st.blocks.start.from_numpy(data["b_start"])
-        st.blocks.count.from_numpy(data["b_count"])
+    if st.blocks is not None:
+        if "b_start" in data:
+            st.blocks.start.from_numpy(data["b_start"])
+            st.blocks.count.from_numpy(data["b_count"])
+        st.blocks.clear_sums()  # a refused step's heat (its Newton raised before its end)
     st.scalars.step[None] = int(data["steps"])
 
 
