@@ -367,7 +367,10 @@ class Simulation(NeckMeasures):
         if self.adaptive is not None and "adaptive_dt" in extra:
             self.adaptive.dt = float(extra.pop("adaptive_dt"))
         if self.handover is None:
-            self.dt = float(self.state.scalars.dt[None])
+            if self.adaptive is None:
+                self.dt = float(self.state.scalars.dt[None])
+            # else dt stays the run's first step: the frame times are its multiples (the
+            # checkpoint's dt is the last adaptive step; taken as dt it moved every later frame)
             return extra
         h = self.handover  # the hybrid's dt stays its explicit step
         if "hybrid_explicit" in extra:
