@@ -152,6 +152,7 @@ class ImplicitFields:
         if cfg.heat_implicit:  # backward-Euler heat (solver/implicit_heat.py)
             self.conductance = ti.field(float, grid + (WIDTH,) * cfg.dim)
             self.heat_node = ti.field(ti.i32, grid)  # physics.codes.HeatNode
+            self.heat_dof = ti.field(ti.i32, grid)  # a free node's unknown (-1: none)
 
 
 @ti.data_oriented

@@ -10,8 +10,9 @@ One step, over the explicit step's stages (solver/step.py) where they are the sa
     Newton     R(v) = (m / dt + dt K^cap) v - (m v^n / dt + f^ext + f^cap) - f^int(v) = 0 over
                the grid velocity components that are free (node mass above the cut-off, walls
                removed): f^int from each point's Perzyna update with L(v) (not kept), the
-               tangent from its secant moduli; a sparse solve per iteration and a backtracking
-               line search on |R|
+               tangent from its secant moduli at v^n, factorized once and kept while Newton
+               contracts fast (a new one where it does not); a sparse solve per iteration and
+               a backtracking line search on |R|
     end        g2p with the converged v (velocity transfer, motion, the stress kept), watch,
                the active region, the clock
 
@@ -30,7 +31,6 @@ conjugate gradients over the next iterations and steps. The matrix is symmetric 
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 import taichi as ti
 
 from ..config import Case
@@ -40,7 +40,6 @@ from ..physics.grid import active, ramped_gamma
 from ..physics.mechanics import apply_walls, interpolate_velocity
 from ..physics.shape import STENCIL, node_weight
 from ..physics.stiffness import (
-    REACH,
     WIDTH,
     capillary_tangent,
     scatter_mass,
@@ -51,6 +50,7 @@ from . import checkpoint
 from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
+from .implicit_system import GridSystem, dof_index, gather, gather_force
 from .linear_solve import LinearSolver, linear_solver
 from .loops import check_block, grow_box, in_order, point_loop
 from .step import (
@@ -67,6 +67,8 @@ from .step import (
 # the stages of the explicit step that the implicit one runs before its Newton loop
 BEFORE = (clear_grid, p2g, surface_force)
 LINE_SEARCH_HALVINGS = 8
+# Newton keeps its matrix while an iteration cuts the residual to this fraction or less
+SLOW_CONTRACTION = 0.5
 # the relative residual of a Newton step's linear solve (an inexact Newton direction: the
 # iteration itself drives the momentum residual to time.newton_tolerance)
 LINEAR_RTOL = 1e-6
@@ -128,8 +130,9 @@ def _begin(st: ti.template()):
 
 
 @ti.func
-def _internal_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    """Point p's internal force of its trial stress and its tangent, at the grid velocity."""
+def _point_force(st: ti.template(), p):
+    """Point p's internal force of its trial stress at the grid velocity, scattered; returns
+    what its tangent needs."""
     pt = ti.static(st.points)
     dt = st.scalars.dt[None]
     base, w, dw = point_stencil(st.cfg, pt, p)
@@ -141,70 +144,53 @@ def _internal_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.temp
         st.implicit.internal[base + o] += -V * (sig @ gN)
     a_lam = dt * (K - 2.0 * mu_t / 3.0) - 2.0 * eta / 3.0
     a_mu = dt * mu_t + eta
+    return base, w, dw, V, a_lam, a_mu
+
+
+@ti.func
+def _force_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    _point_force(st, p)
+
+
+@ti.func
+def _force_and_tangent_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
+    base, w, dw, V, a_lam, a_mu = _point_force(st, p)
     scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
 
 
 @ti.kernel
-def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.ndarray()):
-    """The grid velocity from the unknowns v, then f^int(v) and the points' tangent."""
+def internal_force(
+    st: ti.template(),
+    v: ti.types.ndarray(),
+    dof_node: ti.types.ndarray(),
+    tangent: ti.template(),
+):
+    """The grid velocity from the unknowns v, then f^int(v) and (``tangent``) the points'
+    tangent."""
     if ti.static(st.cfg.parallel):
-        _internal_force(st, v, dof_node)
+        _internal_force(st, v, dof_node, tangent)
     else:
         ti.loop_config(serialize=True)
         for _ in range(1):
-            _internal_force(st, v, dof_node)
+            _internal_force(st, v, dof_node, tangent)
 
 
 @ti.func
-def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
+def _internal_force(
+    st: ti.template(), v: ti.template(), dof_node: ti.template(), tangent: ti.template()
+):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
+        if ti.static(tangent):
+            _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
         st.implicit.internal[I] = ti.Vector.zero(float, st.cfg.dim)
         nd.v[I] = ti.Vector.zero(float, st.cfg.dim)
     for k in range(v.shape[0]):
-        nd.v[dof_node[k, 0], dof_node[k, 1]][dof_node[k, 2]] = v[k]
-    point_loop(st, _internal_body, False, False, True)
-
-
-@ti.kernel
-def gather(
-    st: ti.template(),
-    K: ti.template(),
-    dof_node: ti.types.ndarray(),
-    cols: ti.types.ndarray(),
-    vals: ti.types.ndarray(),
-    vec: ti.types.ndarray(),
-    guess: ti.types.ndarray(),
-    fixed: ti.template(),
-):
-    """Row k of matrix K (the WIDTH^dim x dim slots of node-component k; cols -1 where the
-    neighbour's component is not an unknown) and, ``fixed``: the columns, the right-hand side
-    m v^n / dt + f into vec and v^n into guess; else: the internal force into vec."""
-    nd = ti.static(st.nodes)
-    for k in range(vals.shape[0]):
-        I = ti.Vector([dof_node[k, 0], dof_node[k, 1]])
-        a = dof_node[k, 2]
-        for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
-            o = stencil_offset(r, st.cfg.dim, WIDTH)
-            J = I + o - REACH
-            inside = (J >= 0).all() and (J < ti.Vector([st.cfg.nx, st.cfg.ny])).all()
-            for b in ti.static(range(st.cfg.dim)):
-                slot = r * st.cfg.dim + b
-                c = -1
-                if inside:
-                    c = st.implicit.dof[J][b]
-                value = 0.0
-                if c >= 0:
-                    value = K[I, o, a, b]
-                vals[k, slot] = value
-                if ti.static(fixed):
-                    cols[k, slot] = c
-        if ti.static(fixed):
-            vec[k] = nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]
-            guess[k] = nd.v[I][a]
-        else:
-            vec[k] = st.implicit.internal[I][a]
+        nd.v[dof_index(st, dof_node, k)][dof_node[k, st.cfg.dim]] = v[k]
+    if ti.static(tangent):
+        point_loop(st, _force_and_tangent_body, False, False, True)
+    else:
+        point_loop(st, _force_body, False, False, True)
 
 
 @ti.func
@@ -225,34 +211,7 @@ def end(st: ti.template()):
     advance_clock(st, True, True)
 
 
-# ----------------------------------------------------------------------------- linear solve
 # ----------------------------------------------------------------------------- the step
-@dataclass
-class GridSystem:
-    """One step's unknowns and the fixed part of its matrix. Unknown k is velocity component
-    ``dof_node[k, 2]`` of node ``dof_node[k, :2]``; ``slots`` picks the stored entries of the
-    WIDTH^dim x dim slots of each row (the neighbours' components that are unknowns too), which
-    ``indices`` and ``indptr`` lay out as a CSR matrix (columns sorted: unknowns are numbered
-    node by node in index order, and the slots run the same way)."""
-
-    dof_node: np.ndarray
-    slots: np.ndarray
-    indices: np.ndarray
-    indptr: np.ndarray
-    fixed: np.ndarray  # inertia and capillary stiffness, on the stored entries
-    rhs: np.ndarray  # m v^n / dt + f^ext + f^cap
-    v0: np.ndarray  # v^n (walls applied): Newton's first iterate
-
-    @property
-    def n(self) -> int:
-        return len(self.rhs)
-
-    def matrix(self, values: np.ndarray) -> sp.csr_matrix:
-        A = sp.csr_matrix((values, self.indices, self.indptr), shape=(self.n, self.n))
-        A.has_sorted_indices = True
-        return A
-
-
 class ImplicitStepper:
     """Backward-Euler steps of one State (module docstring)."""
 
@@ -284,6 +243,9 @@ class ImplicitStepper:
         st.scalars.dt_heat[None] = WARM_UP_FRACTION * float(scalars["dt_heat"])
         try:
             (stepper or self).step()
+            sys_ = self.prepare()  # the force without the tangent, which the step may not reach
+            if sys_.n:
+                self.internal(sys_, sys_.v0, tangent=False)
         except SimulationError:
             pass  # compiled as far as it went; the run's own step reports a failure
         checkpoint.restore(st, saved)
@@ -323,12 +285,18 @@ class ImplicitStepper:
         indptr = np.concatenate([[0], np.cumsum(slots.sum(axis=1))])
         return GridSystem(dof_node, slots, cols[slots], indptr, fixed[slots], rhs, v0)
 
-    def internal(self, sys_: GridSystem, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """f^int(v) at the unknowns and the points' tangent on the stored entries."""
+    def internal(
+        self, sys_: GridSystem, v: np.ndarray, tangent: bool = True
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """f^int(v) at the unknowns and (``tangent``) the points' tangent on the stored
+        entries."""
         st = self.st
-        internal_force(st, v, sys_.dof_node)
-        vals = np.empty((sys_.n, self._slots))
+        internal_force(st, v, sys_.dof_node, tangent)
         f_int = np.empty(sys_.n)
+        if not tangent:
+            gather_force(st, sys_.dof_node, f_int)
+            return f_int, None
+        vals = np.empty((sys_.n, self._slots))
         unused = np.empty((1, 1), dtype=np.int32)
         gather(st, st.implicit.tangent, sys_.dof_node, unused, vals, f_int, f_int, False)
         return f_int, vals[sys_.slots]
@@ -343,15 +311,19 @@ class ImplicitStepper:
 
     def newton(self, sys_: GridSystem) -> np.ndarray:
         """Newton with a backtracking line search from v^n to |R| <= tol x scale; leaves the
-        converged velocity on the grid and returns it."""
+        converged velocity on the grid and returns it. The matrix (its tangent) is taken at v^n
+        and kept while each iteration cuts the residual by SLOW_CONTRACTION or more at a full
+        step, else taken afresh at the new iterate: a tangent that changes little over a step
+        then costs one factorization and one point pass of the tangent per step."""
         st = self.st
         how = linear_solver(self.case, sys_.n)
         if self.linear is None or self.linear.how != how:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
+        A = sys_.matrix(sys_.fixed + tangent)
         R, scale = self.residual(sys_, v, f_int)
-        it = 0
+        it, fresh = 0, True
         while not np.linalg.norm(R) <= self.tol * scale:  # NaN too
             if it == self.max_iterations or not np.isfinite(R).all():
                 raise NewtonError(
@@ -360,18 +332,23 @@ class ImplicitStepper:
                     f"{np.linalg.norm(R) / scale:.2e} of the force scale, tolerance {self.tol:g}); "
                     "try a smaller time.dt_s or a larger time.newton_max_iterations"
                 )
-            dv = self.linear.solve(sys_.matrix(sys_.fixed + tangent), -R)
+            dv = self.linear.solve(A, -R, refresh=fresh)
+            fresh = False
             norm0 = np.linalg.norm(R)
             alpha = 1.0
             for _ in range(LINE_SEARCH_HALVINGS):
                 v_try = v + alpha * dv
-                f_try, tan_try = self.internal(sys_, v_try)
+                f_try, _ = self.internal(sys_, v_try, tangent=False)
                 R_try, scale_try = self.residual(sys_, v_try, f_try)
                 if np.linalg.norm(R_try) < norm0:
                     break
                 alpha *= 0.5
-            v, f_int, tangent, R, scale = v_try, f_try, tan_try, R_try, scale_try
+            v, f_int, R, scale = v_try, f_try, R_try, scale_try
             it += 1
+            slow = alpha < 1.0 or np.linalg.norm(R) > SLOW_CONTRACTION * norm0
+            if slow and not np.linalg.norm(R) <= self.tol * scale:
+                f_int, tangent = self.internal(sys_, v)
+                A, fresh = sys_.matrix(sys_.fixed + tangent), True
         self.newton_total += it
         self.last = StepReport(it, sys_.n, float(np.linalg.norm(R) / scale), how)
         return v

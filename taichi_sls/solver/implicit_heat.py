@@ -21,8 +21,6 @@ bounds the temperature change per step through the melting and freezing ranges, 
 capacity varies.
 """
 
-import itertools
-
 import numpy as np
 import scipy.sparse as sp
 import taichi as ti
@@ -30,7 +28,7 @@ import taichi as ti
 from ..config import Case
 from ..physics.codes import HeatNode
 from ..physics.grid import active
-from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
+from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance, stencil_offset
 from ..physics.thermal import fixed_temperature, point_conductivity
 from .fields import State
 from .linear_solve import LinearSolver, linear_solver
@@ -102,15 +100,55 @@ def finish(st: ti.template()):
     point_loop(st, _heat_body, True, False, False)
 
 
-def _row_neighbours(shape: tuple[int, ...], rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(neighbour flat index, valid) of each row node's WIDTH^dim slots, the last axis fastest
-    (the order of the conductance field's row)."""
-    coords = np.stack(np.unravel_index(rows, shape), axis=1)  # (rows, dim)
-    offsets = np.array(list(itertools.product(range(-REACH, REACH + 1), repeat=len(shape))))
-    nb = coords[:, None, :] + offsets[None, :, :]
-    valid = ((nb >= 0) & (nb < np.array(shape))).all(axis=2)
-    nb = np.where(valid[..., None], nb, 0)
-    return np.ravel_multi_index(tuple(np.moveaxis(nb, 2, 0)), shape), valid
+@ti.func
+def _neighbour_unknown(st: ti.template(), I, r):
+    """Slot r of node I's row (the WIDTH^dim nodes around it, the last axis fastest): the
+    neighbour's offset in the row and its unknown (-1: outside the grid or not free)."""
+    o = stencil_offset(r, st.cfg.dim, WIDTH)
+    J = I + o - REACH
+    c = -1
+    if (J >= 0).all() and (J < ti.Vector(ti.static(st.implicit.heat_dof.shape))).all():
+        c = st.implicit.heat_dof[J]
+    return o, c
+
+
+@ti.kernel
+def gather_rows(
+    st: ti.template(),
+    nodes: ti.types.ndarray(),
+    cols: ti.types.ndarray(),
+    vals: ti.types.ndarray(),
+    rhs: ti.types.ndarray(),
+):
+    """Row k of C / dt + K_ff for the free node ``nodes[k]``: its slots' columns (-1: none) and
+    values, and Q^n into rhs."""
+    nd = ti.static(st.nodes)
+    dt = st.scalars.dt_heat[None]
+    for k in range(nodes.shape[0]):
+        I = ti.Vector([nodes[k, a] for a in ti.static(range(st.cfg.dim))])
+        for r in range(WIDTH**st.cfg.dim):
+            o, c = _neighbour_unknown(st, I, r)
+            value = 0.0
+            if c >= 0:
+                value = st.implicit.conductance[I, o]
+                if (o == REACH).all():
+                    value += nd.heat_capacity[I] / dt
+            vals[k, r] = value
+            cols[k, r] = c
+        rhs[k] = nd.heat_rate[I]
+
+
+@ti.kernel
+def conduct(st: ti.template(), dT: ti.types.ndarray()):
+    """Q_i -= (K dT)_i at every node with a heat capacity, the fixed ones too (their heat out)."""
+    for I in ti.grouped(st.implicit.heat_node):
+        if st.implicit.heat_node[I] != HeatNode.EMPTY:
+            flow = 0.0
+            for r in range(WIDTH**st.cfg.dim):
+                o, c = _neighbour_unknown(st, I, r)
+                if c >= 0:
+                    flow += st.implicit.conductance[I, o] * dT[c]
+            st.nodes.heat_rate[I] -= flow
 
 
 class StepHeat:
@@ -148,32 +186,28 @@ class StepHeat:
         st.scalars.t[None] = t0
 
     def _backward_euler(self) -> None:
-        st, nd = self.st, self.st.nodes
+        st = self.st
         in_order(st, rates_and_conductance)
-        kind = st.implicit.heat_node.to_numpy().ravel()
-        capacity = nd.heat_capacity.to_numpy().ravel()
-        rate = nd.heat_rate.to_numpy()
-        shape = rate.shape
-        rate = rate.ravel()
-        rows = np.flatnonzero(kind != HeatNode.EMPTY)
-        cols, valid = _row_neighbours(shape, rows)
-        K = st.implicit.conductance.to_numpy().reshape(len(kind), -1)[rows]
-        keep = valid & (K != 0.0)
+        kind = st.implicit.heat_node.to_numpy()
         free = kind == HeatNode.FREE
-        unknown = np.full(len(kind), -1)
-        unknown[free] = np.arange(int(free.sum()))
-        keep &= free[cols]  # the columns of the unknowns only: fixed nodes do not change
-        r = np.repeat(np.arange(len(rows)), keep.sum(axis=1))
-        K_rows = sp.csr_matrix(
-            (K[keep], (r, unknown[cols[keep]])), shape=(len(rows), int(free.sum()))
-        )
-        is_free = free[rows]
-        dt = float(st.scalars.dt_heat[None])
-        A = (K_rows[is_free] + sp.diags(capacity[free] / dt)).tocsr()
-        how = linear_solver(self.case, A.shape[0])
-        if self.linear is None or self.linear.how != how:
-            self.linear = LinearSolver(how, HEAT_RTOL)
-        dT = self.linear.solve(A, rate[free]) if A.shape[0] else np.zeros(0)
-        rate[rows] -= K_rows @ dT
-        nd.heat_rate.from_numpy(rate.reshape(shape))
+        unknown = np.full(kind.shape, -1, dtype=np.int32)
+        n = int(free.sum())
+        unknown[free] = np.arange(n, dtype=np.int32)
+        st.implicit.heat_dof.from_numpy(unknown)
+        if n:
+            nodes = np.ascontiguousarray(np.argwhere(free).astype(np.int32))
+            slots = WIDTH**st.cfg.dim
+            cols = np.empty((n, slots), dtype=np.int32)
+            vals, rhs = np.empty((n, slots)), np.empty(n)
+            gather_rows(st, nodes, cols, vals, rhs)
+            stored = cols >= 0  # columns ascend: unknowns and slots both run in index order
+            A = sp.csr_matrix(
+                (vals[stored], cols[stored], np.concatenate([[0], np.cumsum(stored.sum(1))])),
+                shape=(n, n),
+            )
+            A.has_sorted_indices = True
+            how = linear_solver(self.case, n)
+            if self.linear is None or self.linear.how != how:
+                self.linear = LinearSolver(how, HEAT_RTOL)
+            conduct(st, self.linear.solve(A, rhs))
         in_order(st, finish)

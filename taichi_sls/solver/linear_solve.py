@@ -6,17 +6,22 @@ factorization is kept and, while the next matrix has the same sparsity pattern, 
 preconditions conjugate gradients on that matrix; when CG needs more than ``refresh_after``
 iterations (the matrix has drifted) the factorization is refreshed.
 
+A solve may ask for a fresh factorization (``refresh``): the implicit step asks whenever it
+takes a new tangent, and solves with that very matrix over its next Newton iterations (direct:
+the factorization alone, no CG). CG is written out here (``preconditioned_cg``): its iterations
+are few, and scipy's wrapper cost as much per call as two of them.
+
 - ``direct``: LDL^T with AMD ordering (qdldl; its numeric refactorization reuses the symbolic
   one when the pattern is unchanged): exact for the matrix it was built from.
 - ``amg``: pyamg's smoothed-aggregation hierarchy as the preconditioner (memory and time linear
   in the unknowns, for the large systems where a factorization's fill grows too big).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..config import Case
 
@@ -53,24 +58,31 @@ class LinearSolver:
         self.stats = SolveStats()
         self._pattern: tuple[np.ndarray, np.ndarray] | None = None
         self._factor = None
-        self._precondition: spla.LinearOperator | None = None
+        self._factored: sp.csr_matrix | None = None  # the matrix the factorization is of
+        self._precondition: Callable[[np.ndarray], np.ndarray] | None = None
 
-    def solve(self, A: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
+    def solve(self, A: sp.csr_matrix, b: np.ndarray, refresh: bool = False) -> np.ndarray:
+        """x with |A x - b| <= rtol |b|; ``refresh``: factorize A afresh (direct: solve with it;
+        amg: a new hierarchy) even where the kept one would do."""
         self.stats.solves += 1
-        if not self._same_pattern(A):
-            self._factorize(A, new_pattern=True)
+        rtol = self.rtol
+        if A is self._factored and self.how == "direct":
+            return self._factor.solve(b)
+        same = self._same_pattern(A)
+        if refresh or not same:
+            self._factorize(A, new_pattern=not same)
             if self.how == "direct":
                 return self._factor.solve(b)
-        x, converged = self._cg(A, b, self.refresh_after)
+        x, converged = self._cg(A, b, rtol, self.refresh_after)
         if not converged:
             self._factorize(A, new_pattern=False)
             if self.how == "direct":
                 return self._factor.solve(b)
-            x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
+            x, converged = self._cg(A, b, rtol, CG_MAX_ITERATIONS)
             if not converged:
                 raise RuntimeError(
                     f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
-                    f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
+                    f"the relative residual {rtol:g} in {CG_MAX_ITERATIONS} iterations"
                 )
         return x
 
@@ -90,23 +102,51 @@ class LinearSolver:
                 self._factor = qdldl.Solver(csc)
             else:
                 self._factor.update(csc)
-            solve = self._factor.solve
+            self._precondition = self._factor.solve
         else:
             import pyamg
 
             ml = pyamg.smoothed_aggregation_solver(A, symmetry="symmetric", max_coarse=500)
             self._factor = ml
-            solve = ml.aspreconditioner(cycle="V").matvec
+            self._precondition = ml.aspreconditioner(cycle="V").matvec
         self._pattern = (A.indptr.copy(), A.indices.copy())
-        n = A.shape[0]
-        self._precondition = spla.LinearOperator((n, n), matvec=solve, dtype=float)
+        self._factored = A
 
-    def _cg(self, A: sp.csr_matrix, b: np.ndarray, limit: int) -> tuple[np.ndarray, bool]:
-        count = [0]
+    def _cg(
+        self, A: sp.csr_matrix, b: np.ndarray, rtol: float, limit: int
+    ) -> tuple[np.ndarray, bool]:
+        x, iterations, converged = preconditioned_cg(A, b, self._precondition, rtol, limit)
+        self.stats.cg_iterations += iterations
+        return x, converged
 
-        def tick(_x: np.ndarray) -> None:
-            count[0] += 1
 
-        x, info = spla.cg(A, b, rtol=self.rtol, maxiter=limit, M=self._precondition, callback=tick)
-        self.stats.cg_iterations += count[0]
-        return x, info == 0
+def preconditioned_cg(
+    A: sp.csr_matrix,
+    b: np.ndarray,
+    precondition: Callable[[np.ndarray], np.ndarray],
+    rtol: float,
+    limit: int,
+) -> tuple[np.ndarray, int, bool]:
+    """Conjugate gradients from x = 0 to |b - A x| <= rtol |b| in at most ``limit``
+    iterations: (x, iterations, converged). A and the preconditioner symmetric positive
+    definite."""
+    x = np.zeros_like(b)
+    r = b.copy()
+    target = rtol * np.linalg.norm(b)
+    if np.linalg.norm(r) <= target:
+        return x, 0, True
+    z = precondition(r)
+    p = z.copy()
+    rz = r @ z
+    for k in range(1, limit + 1):
+        Ap = A @ p
+        alpha = rz / (p @ Ap)
+        x += alpha * p
+        r -= alpha * Ap
+        if np.linalg.norm(r) <= target:
+            return x, k, True
+        z = precondition(r)
+        rz, rz_old = r @ z, rz
+        p *= rz / rz_old
+        p += z
+    return x, limit, False

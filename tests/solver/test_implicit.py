@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from helpers import deep_update
 
 from taichi_sls.config import CaseError, load_case
-from taichi_sls.solver.linear_solve import LinearSolver
+from taichi_sls.solver.linear_solve import LinearSolver, preconditioned_cg
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.solver.time_step import resolve_dt, resolve_heat_substeps, time_step_limits
 from taichi_sls.studies import verification as ver
@@ -93,6 +93,31 @@ def test_linear_solver_reuses_its_preconditioner(how):
     assert np.linalg.norm(A2 @ x2 - b) <= 1e-7 * np.linalg.norm(b)
     assert solver.stats.factorizations == 1
     assert solver.stats.cg_iterations > 0
+
+
+def test_linear_solver_solves_a_refreshed_matrix_directly():
+    """A fresh factorization solves its own matrix exactly, and the same matrix again without
+    CG or a new factorization (the implicit step's kept tangent); ``preconditioned_cg`` with no
+    preconditioner reaches the residual asked."""
+    n = 30
+    lap = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    A = (sp.kronsum(lap, lap) + 0.01 * sp.eye(n * n)).tocsr()
+    rng = np.random.default_rng(5)
+    b, b2 = rng.normal(size=n * n), rng.normal(size=n * n)
+    solver = LinearSolver("direct", rtol=1e-8)
+    for rhs in (b, b2):
+        x = solver.solve(A, rhs, refresh=rhs is b)
+        assert np.linalg.norm(A @ x - rhs) <= 1e-12 * np.linalg.norm(rhs)
+    assert solver.stats.factorizations == 1 and solver.stats.cg_iterations == 0
+    A2 = A.copy()
+    A2.data *= 1.0 + 0.02 * np.cos(np.arange(A2.nnz))
+    A2 = ((A2 + A2.T) * 0.5).tocsr()
+    x = solver.solve(A2, b, refresh=True)
+    assert solver.stats.factorizations == 2 and solver.stats.cg_iterations == 0
+    assert np.linalg.norm(A2 @ x - b) <= 1e-12 * np.linalg.norm(b)
+    x, iterations, converged = preconditioned_cg(A, b, lambda r: r, 1e-8, 500)
+    assert converged and 0 < iterations < 500
+    assert np.linalg.norm(A @ x - b) <= 1e-8 * np.linalg.norm(b)
 
 
 @pytest.mark.slow
