@@ -28,9 +28,10 @@ import taichi as ti
 from ..config import Case
 from ..physics.codes import HeatNode
 from ..physics.grid import active
-from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance, stencil_offset
+from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
 from ..physics.thermal import fixed_temperature, point_conductivity
 from .fields import State
+from .implicit_system import row_neighbour
 from .linear_solve import LinearSolver, linear_solver
 from .loops import in_order, point_loop
 from .step import (
@@ -104,10 +105,9 @@ def finish(st: ti.template()):
 def _neighbour_unknown(st: ti.template(), I, r):
     """Slot r of node I's row (the WIDTH^dim nodes around it, the last axis fastest): the
     neighbour's offset in the row and its unknown (-1: outside the grid or not free)."""
-    o = stencil_offset(r, st.cfg.dim, WIDTH)
-    J = I + o - REACH
+    o, J, inside = row_neighbour(st.implicit.heat_dof, I, r)
     c = -1
-    if (J >= 0).all() and (J < ti.Vector(ti.static(st.implicit.heat_dof.shape))).all():
+    if inside:
         c = st.implicit.heat_dof[J]
     return o, c
 

@@ -13,6 +13,17 @@ from ..physics.stiffness import REACH, WIDTH, stencil_offset
 
 
 @ti.func
+def row_neighbour(grid: ti.template(), I, r):
+    """Slot r of node I's row (the WIDTH^dim nodes around it, the last axis fastest) on the
+    nodes of field ``grid``: the neighbour's offset in the row, its node and whether it lies in
+    the grid."""
+    o = stencil_offset(r, ti.static(len(grid.shape)), WIDTH)
+    J = I + o - REACH
+    inside = (J >= 0).all() and (J < ti.Vector(ti.static(grid.shape))).all()
+    return o, J, inside
+
+
+@ti.func
 def dof_index(st: ti.template(), dof_node: ti.template(), k):
     """The node of unknown k (its component: ``dof_node[k, dim]``)."""
     return ti.Vector([dof_node[k, a] for a in ti.static(range(st.cfg.dim))])
@@ -44,9 +55,7 @@ def gather(
         I = dof_index(st, dof_node, k)
         a = dof_node[k, st.cfg.dim]
         for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
-            o = stencil_offset(r, st.cfg.dim, WIDTH)
-            J = I + o - REACH
-            inside = (J >= 0).all() and (J < ti.Vector([st.cfg.nx, st.cfg.ny])).all()
+            o, J, inside = row_neighbour(st.implicit.dof, I, r)
             for b in ti.static(range(st.cfg.dim)):
                 slot = r * st.cfg.dim + b
                 c = -1
@@ -68,7 +77,7 @@ def gather(
 @dataclass
 class GridSystem:
     """One step's unknowns and the fixed part of its matrix. Unknown k is velocity component
-    ``dof_node[k, 2]`` of node ``dof_node[k, :2]``; ``slots`` picks the stored entries of the
+    ``dof_node[k, dim]`` of node ``dof_node[k, :dim]``; ``slots`` picks the stored entries of the
     WIDTH^dim x dim slots of each row (the neighbours' components that are unknowns too), which
     ``indices`` and ``indptr`` lay out as a CSR matrix (columns sorted: unknowns are numbered
     node by node in index order, and the slots run the same way)."""

@@ -65,7 +65,6 @@ class LinearSolver:
         """x with |A x - b| <= rtol |b|; ``refresh``: factorize A afresh (direct: solve with it;
         amg: a new hierarchy) even where the kept one would do."""
         self.stats.solves += 1
-        rtol = self.rtol
         if A is self._factored and self.how == "direct":
             return self._factor.solve(b)
         same = self._same_pattern(A)
@@ -73,16 +72,16 @@ class LinearSolver:
             self._factorize(A, new_pattern=not same)
             if self.how == "direct":
                 return self._factor.solve(b)
-        x, converged = self._cg(A, b, rtol, self.refresh_after)
+        x, converged = self._cg(A, b, self.refresh_after)
         if not converged:
             self._factorize(A, new_pattern=False)
             if self.how == "direct":
                 return self._factor.solve(b)
-            x, converged = self._cg(A, b, rtol, CG_MAX_ITERATIONS)
+            x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
             if not converged:
                 raise RuntimeError(
                     f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
-                    f"the relative residual {rtol:g} in {CG_MAX_ITERATIONS} iterations"
+                    f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
                 )
         return x
 
@@ -112,10 +111,8 @@ class LinearSolver:
         self._pattern = (A.indptr.copy(), A.indices.copy())
         self._factored = A
 
-    def _cg(
-        self, A: sp.csr_matrix, b: np.ndarray, rtol: float, limit: int
-    ) -> tuple[np.ndarray, bool]:
-        x, iterations, converged = preconditioned_cg(A, b, self._precondition, rtol, limit)
+    def _cg(self, A: sp.csr_matrix, b: np.ndarray, limit: int) -> tuple[np.ndarray, bool]:
+        x, iterations, converged = preconditioned_cg(A, b, self._precondition, self.rtol, limit)
         self.stats.cg_iterations += iterations
         return x, converged
 
