@@ -138,7 +138,8 @@ class Time(Model):
     )
     linear_solver: Literal["auto", "direct", "amg"] = Field(
         "auto",
-        description="implicit: direct (SuperLU, scipy.sparse), amg (conjugate gradients "
+        description="implicit: direct (CHOLMOD's Cholesky through cvxopt; qdldl's LDL^T where "
+        "a matrix is not positive definite), amg (conjugate gradients "
         "preconditioned by pyamg's smoothed aggregation) or auto (direct up to "
         "direct_max_unknowns grid velocity components, amg above)",
     )

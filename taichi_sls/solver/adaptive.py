@@ -136,6 +136,14 @@ class AdaptiveStepper:
         )
         self.changes = ti.Vector.field(4, float, ())
 
+    def compile(self) -> None:
+        """Compile the kernels that judge a step (they change nothing the run reads before the
+        next step writes it), and the copy back that a refused step makes, so that the first
+        step does not pay for them."""
+        copy_points(self.st.points, self.before)
+        copy_points(self.before, self.st.points)
+        self.changes_ratio(self.dt)
+
     def set_step(self, dt: float) -> None:
         """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
         self.st.scalars.dt[None] = dt

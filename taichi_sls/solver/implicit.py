@@ -304,7 +304,7 @@ class ImplicitStepper:
     @staticmethod
     def residual(sys_: GridSystem, v: np.ndarray, f_int: np.ndarray) -> tuple[np.ndarray, float]:
         """R(v) and the force scale it is measured against (module docstring)."""
-        Av = sys_.matrix(sys_.fixed) @ v
+        Av = sys_.fixed_matrix @ v
         R = Av - sys_.rhs - f_int
         scale = max(np.linalg.norm(Av) + np.linalg.norm(sys_.rhs) + np.linalg.norm(f_int), 1e-300)
         return R, scale

@@ -4,6 +4,7 @@ matrix gathered from the WIDTH^dim node rows the kernels scatter into (physics/s
 laid out as a CSR matrix."""
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -93,6 +94,11 @@ class GridSystem:
     @property
     def n(self) -> int:
         return len(self.rhs)
+
+    @cached_property
+    def fixed_matrix(self) -> sp.csr_matrix:
+        """The fixed part alone, which every residual evaluation multiplies."""
+        return self.matrix(self.fixed)
 
     def matrix(self, values: np.ndarray) -> sp.csr_matrix:
         A = sp.csr_matrix((values, self.indices, self.indptr), shape=(self.n, self.n))

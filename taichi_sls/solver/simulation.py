@@ -134,6 +134,8 @@ class Simulation(NeckMeasures):
             advance(self.explicit_state, 0)  # compiles the explicit step kernel
         if self.implicit is not None:
             self.implicit.compile()
+        if self.adaptive is not None:
+            self.adaptive.compile()
         self.compile_s = time.perf_counter() - t0
         self._mass = self.state.points.mass.to_numpy()
         # each point's index in the order the run started with: the blocks layout sorts the

@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from helpers import deep_update
 
 from taichi_sls.config import CaseError, load_case
-from taichi_sls.solver.linear_solve import LinearSolver, preconditioned_cg
+from taichi_sls.solver.linear_solve import DirectFactor, LinearSolver, preconditioned_cg
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.solver.time_step import resolve_dt, resolve_heat_substeps, time_step_limits
 from taichi_sls.studies import verification as ver
@@ -118,6 +118,24 @@ def test_linear_solver_solves_a_refreshed_matrix_directly():
     x, iterations, converged = preconditioned_cg(A, b, lambda r: r, 1e-8, 500)
     assert converged and 0 < iterations < 500
     assert np.linalg.norm(A @ x - b) <= 1e-8 * np.linalg.norm(b)
+
+
+def test_direct_factor_solves_definite_and_indefinite_matrices_on_one_pattern():
+    """The direct factorization solves an SPD matrix (Cholesky) and, refreshed on the same
+    pattern, a symmetric indefinite one (the LDL^T fallback) and then an SPD one again, each to
+    round-off."""
+    n = 20
+    lap = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    A = (sp.kronsum(lap, lap) + 0.01 * sp.eye(n * n)).tocsr()
+    shifted = (A - 1.5 * sp.eye(n * n)).tocsr()  # eigenvalues on both sides of zero
+    assert shifted.nnz == A.nnz
+    b = np.random.default_rng(7).normal(size=n * n)
+    factor = DirectFactor(A)
+    for matrix, definite in ((A, True), (shifted, False), (2.0 * A, True)):
+        factor.update(matrix)
+        assert factor.cholesky == definite
+        x = factor.solve(b)
+        assert np.linalg.norm(matrix @ x - b) <= 1e-10 * np.linalg.norm(b)
 
 
 @pytest.mark.slow
