@@ -149,11 +149,10 @@ class DirectFactor:
             if self._symbolic is None:
                 self._symbolic = cholmod.symbolic(self._lower)
             cholmod.numeric(self._lower, self._symbolic)
-        except ArithmeticError:  # not positive definite
+        except ArithmeticError:  # not positive definite: LDL^T, and a fresh analysis next time
             import qdldl
 
-            self._symbolic = None  # analysed afresh by the next update
-
+            self._symbolic = None
             self._ldl = qdldl.Solver(A.tocsc())  # symmetric: its CSC is its CSR transposed
 
     @property
