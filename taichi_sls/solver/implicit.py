@@ -51,7 +51,7 @@ from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
 from .implicit_system import GridSystem, dof_index, gather, gather_force
-from .linear_solve import LinearSolver, linear_solver
+from .linear_solve import LinearSolveError, LinearSolver, linear_solver
 from .loops import check_block, grow_box, in_order, point_loop
 from .step import (
     advance_clock,
@@ -324,15 +324,22 @@ class ImplicitStepper:
         A = sys_.matrix(sys_.fixed + tangent)
         R, scale = self.residual(sys_, v, f_int)
         it, fresh = 0, True
+        where = f"implicit step {int(st.scalars.step[None])} (t = {st.scalars.t[None]:.4g} s)"
         while not np.linalg.norm(R) <= self.tol * scale:  # NaN too
             if it == self.max_iterations or not np.isfinite(R).all():
                 raise NewtonError(
-                    f"implicit step {int(st.scalars.step[None])} (t = {st.scalars.t[None]:.4g} s): "
-                    f"Newton did not converge in {it} iterations (residual "
+                    f"{where}: Newton did not converge in {it} iterations (residual "
                     f"{np.linalg.norm(R) / scale:.2e} of the force scale, tolerance {self.tol:g}); "
                     "try a smaller time.dt_s or a larger time.newton_max_iterations"
                 )
-            dv = self.linear.solve(A, -R, refresh=fresh)
+            try:
+                dv = self.linear.solve(A, -R, refresh=fresh)
+            except LinearSolveError as e:  # an adaptive run redoes the step smaller
+                raise NewtonError(
+                    f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "
+                    "and stiffness leaves the matrix near singular (docs/implicit.md): try a "
+                    "smaller time.dt_s or a larger time.implicit_small_mass"
+                ) from e
             fresh = False
             norm0 = np.linalg.norm(R)
             alpha = 1.0

@@ -29,6 +29,11 @@ from ..config import Case
 CG_MAX_ITERATIONS = 500
 
 
+class LinearSolveError(RuntimeError):
+    """No factorization of the matrix exists (singular or indefinite), or conjugate gradients
+    with a fresh preconditioner did not converge."""
+
+
 def linear_solver(case: Case, n: int) -> str:
     """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
     choice = case.time.linear_solver
@@ -80,7 +85,7 @@ class LinearSolver:
                 return self._factor.solve(b)
             x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
             if not converged:
-                raise RuntimeError(
+                raise LinearSolveError(
                     f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
                     f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
                 )
@@ -153,7 +158,13 @@ class DirectFactor:
             import qdldl
 
             self._symbolic = None
-            self._ldl = qdldl.Solver(A.tocsc())  # symmetric: its CSC is its CSR transposed
+            try:
+                self._ldl = qdldl.Solver(A.tocsc())  # symmetric: its CSC is its CSR transposed
+            except RuntimeError as e:  # a zero pivot: singular, or not quasi-definite
+                raise LinearSolveError(
+                    f"neither Cholesky nor LDL^T factorizes the {A.shape[0]} x {A.shape[0]} "
+                    f"matrix ({e})"
+                ) from e
 
     @property
     def cholesky(self) -> bool:

@@ -7,7 +7,13 @@ import scipy.sparse as sp
 from helpers import deep_update
 
 from taichi_sls.config import CaseError, load_case
-from taichi_sls.solver.linear_solve import DirectFactor, LinearSolver, preconditioned_cg
+from taichi_sls.solver.implicit import ImplicitStepper, NewtonError
+from taichi_sls.solver.linear_solve import (
+    DirectFactor,
+    LinearSolveError,
+    LinearSolver,
+    preconditioned_cg,
+)
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.solver.time_step import resolve_dt, resolve_heat_substeps, time_step_limits
 from taichi_sls.studies import verification as ver
@@ -136,6 +142,28 @@ def test_direct_factor_solves_definite_and_indefinite_matrices_on_one_pattern():
         assert factor.cholesky == definite
         x = factor.solve(b)
         assert np.linalg.norm(matrix @ x - b) <= 1e-10 * np.linalg.norm(b)
+
+
+def test_a_singular_newton_matrix_refuses_the_step(monkeypatch):
+    """A matrix that neither Cholesky nor LDL^T factorizes (singular: a zero pivot) raises
+    LinearSolveError, and the implicit step turns it into a NewtonError naming the step, so
+    that an adaptive run redoes the step smaller and a fixed-step run stops through its guard
+    path (failed_state.npz) rather than with qdldl's RuntimeError, as it did."""
+    singular = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
+    with pytest.raises(LinearSolveError, match="neither Cholesky nor LDL"):
+        LinearSolver("direct", 1e-6).solve(singular, np.ones(2))
+    sim = _stepped_disc()
+    internal = ImplicitStepper.internal
+
+    def singular_tangent(self, system, v, tangent=True):
+        f_int, stiffness = internal(self, system, v, tangent)
+        if tangent:  # the step's matrix, fixed part plus tangent, of ones: rank one
+            stiffness = 1.0 - system.fixed
+        return f_int, stiffness
+
+    monkeypatch.setattr(ImplicitStepper, "internal", singular_tangent)
+    with pytest.raises(NewtonError, match=r"implicit step 1 .*linear solve failed"):
+        sim.advance(1)
 
 
 @pytest.mark.slow
