@@ -136,6 +136,16 @@ class Time(Model):
         "supports reach has a velocity its equations barely fix, and points nearer to it "
         "inverted or blew up (docs/implicit.md)",
     )
+    implicit_velocity_penalty: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description="implicit: 0, or a penalty on the grid velocity's second differences "
+        "(zero on linear velocity fields) of this fraction of the step's largest matrix "
+        "diagonal: it stiffens the near-null modes of light nodes, which only their inertia "
+        "fixes, against runaway velocities (docs/implicit.md); 1e-6 steadies hopper_pa12 at "
+        "R0/h = 20 and time.newton_tolerance = 1e-8",
+    )
     linear_solver: Literal["auto", "direct", "amg"] = Field(
         "auto",
         description="implicit: direct (CHOLMOD's Cholesky through cvxopt; qdldl's LDL^T where "

@@ -12,7 +12,9 @@ One step, over the explicit step's stages (solver/step.py) where they are the sa
                removed): f^int from each point's Perzyna update with L(v) (not kept), the
                tangent from its secant moduli at v^n, factorized once and kept while Newton
                contracts fast (a new one where it does not); a sparse solve per iteration and
-               a backtracking line search on |R|
+               a backtracking line search on |R|; with ``time.implicit_velocity_penalty``
+               a penalty on the velocity's second differences in the fixed part, against the
+               light nodes' near-null modes
     end        g2p with the converged v (velocity transfer, motion, the stress kept), watch,
                the active region, the clock
 
@@ -221,6 +223,7 @@ class ImplicitStepper:
         self.heat = StepHeat(case, st, heat_substeps)  # 0 substeps: no heat
         self.tol = case.time.newton_tolerance
         self.max_iterations = case.time.newton_max_iterations
+        self.penalty = case.time.implicit_velocity_penalty
         self.last = StepReport()
         self.newton_total = 0
         self.linear: LinearSolver | None = None
@@ -321,6 +324,9 @@ class ImplicitStepper:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
+        if self.penalty > 0.0:  # the light nodes' near-null modes (module docstring)
+            stiffest = np.abs(sys_.fixed + tangent)[sys_.diagonal].max()
+            sys_.add_to_fixed(self.penalty * stiffest * sys_.second_differences())
         A = sys_.matrix(sys_.fixed + tangent)
         R, scale = self.residual(sys_, v, f_int)
         it, fresh = 0, True
@@ -330,7 +336,8 @@ class ImplicitStepper:
                 raise NewtonError(
                     f"{where}: Newton did not converge in {it} iterations (residual "
                     f"{np.linalg.norm(R) / scale:.2e} of the force scale, tolerance {self.tol:g}); "
-                    "try a smaller time.dt_s or a larger time.newton_max_iterations"
+                    "try a smaller time.dt_s or a larger time.newton_max_iterations, or where "
+                    "light nodes run away (docs/implicit.md) time.implicit_velocity_penalty = 1e-6"
                 )
             try:
                 dv = self.linear.solve(A, -R, refresh=fresh)
@@ -338,7 +345,7 @@ class ImplicitStepper:
                 raise NewtonError(
                     f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "
                     "and stiffness leaves the matrix near singular (docs/implicit.md): try a "
-                    "smaller time.dt_s or a larger time.implicit_small_mass"
+                    "smaller time.dt_s or time.implicit_velocity_penalty = 1e-6"
                 ) from e
             fresh = False
             norm0 = np.linalg.norm(R)

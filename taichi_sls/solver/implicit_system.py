@@ -104,3 +104,44 @@ class GridSystem:
         A = sp.csr_matrix((values, self.indices, self.indptr), shape=(self.n, self.n))
         A.has_sorted_indices = True
         return A
+
+    @property
+    def diagonal(self) -> np.ndarray:
+        """Where the stored entries hold the diagonal."""
+        rows = np.repeat(np.arange(self.n), np.diff(self.indptr))
+        return np.flatnonzero(rows == self.indices)
+
+    def second_differences(self) -> np.ndarray:
+        """On the stored entries: the sum of w w^T, w = (1, -2, 1), over the triples of
+        unknowns (i - e, i, i + e) of one component along each axis. Zero on any linear
+        velocity field; positive on a node that moves against its neighbours. All three lie
+        within REACH of each other, so the matrix's pattern holds every entry."""
+        dim = self.dof_node.shape[1] - 1
+        node, comp = self.dof_node[:, :dim].astype(np.int64), self.dof_node[:, dim]
+        node = node - node.min(axis=0) + 1  # a ring of non-unknowns around them
+        unknown = np.full((*(node.max(axis=0) + 2), dim), -1, dtype=np.int64)
+        unknown[(*node.T, comp)] = np.arange(self.n)
+        rows, cols, vals = [], [], []
+        weights = np.array([1.0, -2.0, 1.0])
+        for axis in range(dim):
+            step = np.eye(dim, dtype=np.int64)[axis]
+            below = unknown[(*(node - step).T, comp)]
+            above = unknown[(*(node + step).T, comp)]
+            ok = (below >= 0) & (above >= 0)
+            triple = (below[ok], np.flatnonzero(ok), above[ok])
+            for a in range(3):
+                for b in range(3):
+                    rows.append(triple[a])
+                    cols.append(triple[b])
+                    vals.append(np.full(ok.sum(), weights[a] * weights[b]))
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        keys = np.repeat(np.arange(self.n), np.diff(self.indptr)) * self.n + self.indices
+        where = np.searchsorted(keys, rows * self.n + cols)
+        values = np.zeros(len(self.indices))
+        np.add.at(values, where, np.concatenate(vals))
+        return values
+
+    def add_to_fixed(self, values: np.ndarray) -> None:
+        """Add values on the stored entries to the fixed part (before any residual)."""
+        self.fixed = self.fixed + values
+        self.__dict__.pop("fixed_matrix", None)
