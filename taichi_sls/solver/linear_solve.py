@@ -100,10 +100,14 @@ class LinearSolver:
     def _factorize(self, A: sp.csr_matrix, new_pattern: bool) -> None:
         self.stats.factorizations += 1
         if self.how == "direct":
-            if new_pattern or self._factor is None:
-                self._factor = DirectFactor(A)
-            else:
-                self._factor.update(A)
+            try:
+                if new_pattern or self._factor is None:
+                    self._factor = DirectFactor(A)
+                else:
+                    self._factor.update(A)
+            except LinearSolveError:  # nothing kept: the next matrix starts afresh
+                self._factor = self._factored = self._pattern = None
+                raise
             self._precondition = self._factor.solve
         else:
             import pyamg

@@ -206,8 +206,13 @@ def test_a_singular_newton_matrix_refuses_the_step(monkeypatch):
     that an adaptive run redoes the step smaller and a fixed-step run stops through its guard
     path (failed_state.npz) rather than with qdldl's RuntimeError, as it did."""
     singular = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
+    definite = sp.csr_matrix(np.array([[2.0, 1.0], [1.0, 2.0]]))
+    solver = LinearSolver("direct", 1e-6)
+    solver.solve(definite, np.ones(2))
     with pytest.raises(LinearSolveError, match="neither Cholesky nor LDL"):
-        LinearSolver("direct", 1e-6).solve(singular, np.ones(2))
+        solver.solve(singular, np.ones(2), refresh=True)
+    # nothing of the failed factorization is kept: the next matrix is solved exactly
+    assert np.allclose(definite @ solver.solve(definite, np.ones(2)), np.ones(2), rtol=1e-12)
     sim = _stepped_disc()
     internal = ImplicitStepper.internal
 
