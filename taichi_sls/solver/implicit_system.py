@@ -105,11 +105,15 @@ class GridSystem:
         A.has_sorted_indices = True
         return A
 
+    @cached_property
+    def entry_rows(self) -> np.ndarray:
+        """The row of each stored entry."""
+        return np.repeat(np.arange(self.n), np.diff(self.indptr))
+
     @property
     def diagonal(self) -> np.ndarray:
         """Where the stored entries hold the diagonal."""
-        rows = np.repeat(np.arange(self.n), np.diff(self.indptr))
-        return np.flatnonzero(rows == self.indices)
+        return np.flatnonzero(self.entry_rows == self.indices)
 
     def second_differences(self) -> np.ndarray:
         """On the stored entries: the sum of w w^T, w = (1, -2, 1), over the triples of
@@ -135,7 +139,7 @@ class GridSystem:
                     cols.append(triple[b])
                     vals.append(np.full(ok.sum(), weights[a] * weights[b]))
         rows, cols = np.concatenate(rows), np.concatenate(cols)
-        keys = np.repeat(np.arange(self.n), np.diff(self.indptr)) * self.n + self.indices
+        keys = self.entry_rows * self.n + self.indices
         where = np.searchsorted(keys, rows * self.n + cols)
         values = np.zeros(len(self.indices))
         np.add.at(values, where, np.concatenate(vals))
