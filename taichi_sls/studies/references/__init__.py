@@ -10,10 +10,12 @@ input and ``numpy.ndarray`` otherwise.
 - :mod:`.perzyna`: Perzyna overstress viscoplasticity;
 - :mod:`.stefan`: Stefan melting with a linear mushy zone;
 - :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc;
-- :mod:`.hopper`: the coalescence of two equal viscous cylinders (Hopper 1984, 1990).
+- :mod:`.hopper`: the coalescence of two equal viscous cylinders (Hopper 1984, 1990);
+- :mod:`.crystallization`: isothermal Avrami, non-isothermal Nakamura, DSC peak vs cooling rate.
 """
 
 from .capillarity import *  # noqa: F403
+from .crystallization import *  # noqa: F403
 from .heat import *  # noqa: F403
 from .hopper import *  # noqa: F403
 from .mechanics import *  # noqa: F403
