@@ -26,7 +26,7 @@ from matplotlib.patches import Patch
 from .contacts_plot import KINDS, contact_kind
 from .frames import MATERIAL_LEVEL, material_raster, point_spacing, save_png
 
-SOLID_COLOUR = "#c9ced6"  # powder that never melted: light grey
+SOLID_COLOUR = "#c9ced6"  # powder never fully molten: light grey
 MELTED_COLOUR = "#f3c58f"  # powder that was fully molten at some time: light orange
 PIXELS_PER_SPACING = 2  # raster resolution of the map, per point spacing
 NECK_HISTS = (  # (column, label, colour) of the histogram
@@ -123,7 +123,7 @@ def _draw_map(
         ax.set_xlim(corner[0], corner[0] + nx * pixel)
         top = corner[1] + ny * pixel
         ax.set_ylim(corner[1], top + 0.3 * (top - corner[1]))  # room for the legend
-    handles = [Patch(facecolor=SOLID_COLOUR, label="powder")]
+    handles = [Patch(facecolor=SOLID_COLOUR, label="never fully molten")]
     if time_molten is not None:
         handles.append(Patch(facecolor=MELTED_COLOUR, label="fully molten at some time"))
     for kind, colour in KINDS.items():

@@ -118,6 +118,7 @@ SERIES_LABELS.update(
         "contacts_fused": "fused",
     }
 )
+START_LABEL = "value at t = 0"
 GROUP_STYLES = {"contacts": {"color": "0.6", "ls": "--"}}  # the total: a reference line
 
 
@@ -127,10 +128,11 @@ def plot_series(
     columns: Sequence[Panel],
     per_row: int | None = None,
     events: dict[str, float] | None = None,
+    start_lines: bool = False,
 ) -> bool:
     """Write :func:`series_figure` to ``png_path``; False (and nothing written) when it has
     nothing to plot."""
-    fig = series_figure(csv_path, columns, per_row, events)
+    fig = series_figure(csv_path, columns, per_row, events, start_lines)
     if fig is None:
         return False
     save_png(fig, Path(png_path), dpi=100)
@@ -142,10 +144,13 @@ def series_figure(
     columns: Sequence[Panel],
     per_row: int | None = None,
     events: dict[str, float] | None = None,
+    start_lines: bool = False,
 ) -> Figure | None:
     """Each of ``columns`` (those present; see Panel) against ``t_s`` in microseconds, one
     panel each, ``per_row`` panels to a row (default: all in one), on a log axis when the times
-    span more than LOG_AXIS_DECADES decades; ``events`` (label: time in s) as dotted verticals.
+    span more than LOG_AXIS_DECADES decades; ``events`` (label: time in s) as dotted verticals;
+    with ``start_lines``, a one-column panel on a log axis shows its value at t = 0 (which the
+    axis cannot) as a dashed line. The figure's title says what the lines mark.
 
     None when there is nothing to plot: fewer than two rows, no ``t_s`` column or none of
     ``columns`` present. Unparseable cells plot as gaps.
@@ -189,13 +194,20 @@ def series_figure(
             else:
                 ax.plot(t_us[keep], col(name)[keep], lw=1.2, **style)
             ax.lines[-1].set_label(line_label)
+        if start_lines and log_axis and len(cols) == 1 and t_us[0] == 0.0:
+            ax.axhline(col(cols[0])[0], color="0.6", lw=0.8, ls="--", label=START_LABEL)
         for event, t_s in (events or {}).items():
             ax.axvline(t_s * 1e6, color="0.4", lw=0.8, ls=":", label=event)
-        if len(cols) > 1 or events:
+        if len(cols) > 1:
             ax.legend(fontsize=7)
         ax.set_xlabel("t [us]")
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
+    notes = [f"dotted: {e} at {t_s * 1e6:.4g} us" for e, t_s in (events or {}).items()]
+    if start_lines and log_axis:
+        notes.append(f"dashed: the {START_LABEL}")
+    if notes:
+        fig.suptitle("; ".join(notes), fontsize=9)
     return fig
 
 

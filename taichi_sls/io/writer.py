@@ -140,6 +140,6 @@ class OutputWriter:
                 write_gif(paths, self.out_dir / "animation.gif")
         csv_path, png_path = self.out_dir / "timeseries.csv", self.out_dir / "timeseries.png"
         if self.bed:
-            plot_series(csv_path, png_path, BED_PANELS, BED_PANELS_PER_ROW, events)
+            plot_series(csv_path, png_path, BED_PANELS, BED_PANELS_PER_ROW, events, True)
         else:
             plot_series(csv_path, png_path, [c for c in MONITORED if c in self.series.header])

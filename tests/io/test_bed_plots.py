@@ -21,6 +21,7 @@ from taichi_sls.io.series import (
     BED_PANELS_PER_ROW,
     MONITORED,
     SERIES_LABELS,
+    START_LABEL,
     SeriesWriter,
     series_figure,
 )
@@ -97,7 +98,7 @@ def test_the_bed_series_figure_plots_the_beds_columns(tmp_path: Path) -> None:
     the pair's contact line."""
     cols = write_bed_series(tmp_path / "timeseries.csv")
     fig = series_figure(
-        tmp_path / "timeseries.csv", BED_PANELS, BED_PANELS_PER_ROW, {"beam off": 2.5e-4}
+        tmp_path / "timeseries.csv", BED_PANELS, BED_PANELS_PER_ROW, {"beam off": 2.5e-4}, True
     )
     assert fig is not None
     axes = [ax for ax in fig.axes if ax.get_visible()]
@@ -112,6 +113,10 @@ def test_the_bed_series_figure_plots_the_beds_columns(tmp_path: Path) -> None:
     ]
     assert SERIES_LABELS["contact_line_um"] not in labels
     t_us, keep = cols["t_s"] * 1e6, cols["t_s"] > 0
+    ax_column = {ax: p for ax, p in zip(axes, BED_PANELS, strict=True) if isinstance(p, str)}
+    starts = [ax for ax in axes if START_LABEL in [ln.get_label() for ln in ax.get_lines()]]
+    assert starts == list(ax_column)  # every one-column panel shows its start
+    assert "beam off at 250 us" in fig.get_suptitle()
     plotted = {}
     for ax in axes:
         assert ax.get_xscale() == "log"
@@ -119,6 +124,9 @@ def test_the_bed_series_figure_plots_the_beds_columns(tmp_path: Path) -> None:
             x = np.asarray(line.get_xdata(), dtype=float)
             if line.get_label() == "beam off":
                 assert np.allclose(x, 250.0)
+                continue
+            if line.get_label() == START_LABEL:  # the t = 0 value the log axis cannot show
+                assert np.allclose(line.get_ydata(), cols[ax_column[ax]][0])
                 continue
             np.testing.assert_allclose(x, t_us[keep])
             plotted[line.get_label()] = np.asarray(line.get_ydata(), dtype=float)
@@ -136,7 +144,7 @@ def test_the_bed_series_figure_plots_the_beds_columns(tmp_path: Path) -> None:
         np.testing.assert_allclose(plotted[SERIES_LABELS[name]], cols[name][keep], err_msg=name)
     contacts_ax = axes[labels.index("contacts")]
     legend = [t.get_text() for t in contacts_ax.get_legend().get_texts()]
-    assert {"melted through", "holding melt", "fused", "beam off"} <= set(legend)
+    assert legend == ["all", "melted through", "holding melt", "fused", "beam off"]
 
 
 def test_the_bed_panels_cover_the_beds_series() -> None:
