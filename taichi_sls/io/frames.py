@@ -17,13 +17,16 @@ import io
 import math
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
 matplotlib.use("Agg")  # headless: the solver runs on machines without a display
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import Colormap, ListedColormap
 from matplotlib.figure import Figure
 from scipy.ndimage import correlate1d
 
@@ -163,8 +166,28 @@ def save_png(fig: Figure, path: Path, dpi: int) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
+# A scene wider than this (width / height: a powder layer) stacks its two panels, each across
+# the whole frame, rather than squeezing them side by side into strips a few dozen pixels high.
+STACK_ASPECT = 2.0
+STACKED_WIDTH_IN = 13.0  # inches: 1040 px at the default dpi of 80
+STACKED_PANEL_H_IN = (1.5, 5.0)  # a panel's axes height is clamped to this range (inches)
+# The bed's temperature scale: inferno from a quarter up, so that the powder at the bed
+# temperature (the scale's foot) is a clear purple, not the black of inferno's foot, which reads
+# as shadow or void against the white background.
+BED_T_CMAP_FROM = 0.25
+
+
+def temperature_cmap(bed: bool) -> Colormap:
+    """inferno for a pair (today's frames); for a bed inferno from BED_T_CMAP_FROM up."""
+    base = matplotlib.colormaps["inferno"]
+    if not bed:
+        return base
+    return ListedColormap(base(np.linspace(BED_T_CMAP_FROM, 1.0, 256)), name="inferno_bed")
+
+
 class FramePainter:
-    """Draws one frame into a reused figure of two panels (temperature, deformation)."""
+    """Draws one frame into a reused figure of two panels (temperature, deformation): side by
+    side, or stacked for a scene wider than STACK_ASPECT."""
 
     def __init__(
         self,
@@ -172,23 +195,51 @@ class FramePainter:
         melt_C: float,
         deformation: str,
         dpi: int = 80,
+        bed: bool = False,
     ) -> None:
         self.domain_um = domain_um
         self.melt_C = melt_C
         self.deformation = deformation
         self.dpi = dpi  # the raster's pixel is one pixel of the saved image
+        self.bed = bed
+        xmin, xmax, ymin, ymax = domain_um
+        self.stacked = (xmax - xmin) > STACK_ASPECT * (ymax - ymin)
         self._fig: Figure | None = None
+
+    def _layout(self) -> tuple[Figure, list[Axes], list[dict[str, Any]]]:
+        """The figure, its two axes and each colour bar's placement (keywords of colorbar)."""
+        xmin, xmax, ymin, ymax = self.domain_um
+        if not self.stacked:
+            panel_w = 4.2  # inches; 2 panels + colour bars stay ~800 px wide at dpi 80
+            panel_h = min(max(panel_w * (ymax - ymin) / (xmax - xmin), 1.5), 6.0)
+            fig = Figure(figsize=(2 * panel_w + 1.4, panel_h + 1.0))
+            # Fixed layout (not constrained) so the axes box -- and so the raster -- is known
+            # before drawing and identical across frames.
+            fig.subplots_adjust(left=0.06, right=0.93, bottom=0.14, top=0.86, wspace=0.38)
+            axes = list(fig.subplots(1, 2))
+            return fig, axes, [{"ax": ax, "fraction": 0.046, "pad": 0.03} for ax in axes]
+        # stacked: absolute placements in inches, the axes as wide as the frame allows
+        left, right, cbar_w, cbar_gap = 0.75, 1.25, 0.15, 0.15
+        top, title, ticks, xlabel = 0.45, 0.3, 0.35, 0.25
+        w = STACKED_WIDTH_IN
+        aw = w - left - right
+        lo, hi = STACKED_PANEL_H_IN
+        ah = min(max(aw * (ymax - ymin) / (xmax - xmin), lo), hi)
+        h = top + 2 * (title + ah + ticks) + xlabel
+        fig = Figure(figsize=(w, h))
+        axes, cbars = [], []
+        for i in range(2):
+            y0 = h - top - title - ah - i * (title + ah + ticks)
+            ax = fig.add_axes((left / w, y0 / h, aw / w, ah / h))
+            cax = fig.add_axes(((left + aw + cbar_gap) / w, y0 / h, cbar_w / w, ah / h))
+            axes.append(ax)
+            cbars.append({"cax": cax})
+        return fig, axes, cbars
 
     def _setup_figure(self) -> None:
         xmin, xmax, ymin, ymax = self.domain_um
-        panel_w = 4.2  # inches; 2 panels + colour bars stay ~800 px wide at dpi 80
-        panel_h = min(max(panel_w * (ymax - ymin) / (xmax - xmin), 1.5), 6.0)
-        fig = Figure(figsize=(2 * panel_w + 1.4, panel_h + 1.0))
+        fig, axes, cbar_places = self._layout()
         FigureCanvasAgg(fig)
-        # Fixed layout (not constrained) so the axes box -- and so the raster -- is known before
-        # drawing and identical across frames.
-        fig.subplots_adjust(left=0.06, right=0.93, bottom=0.14, top=0.86, wspace=0.38)
-        axes = fig.subplots(1, 2)
         # Image pixels per micrometre under equal aspect: the tighter of the two directions.
         pos = axes[0].get_position()
         w_in, h_in = fig.get_figwidth() * pos.width, fig.get_figheight() * pos.height
@@ -205,12 +256,15 @@ class FramePainter:
         extent = (xmin, xmin + nx * self._pixel, ymin, ymin + ny * self._pixel)
         cb_label, name = DEFORM_LABELS[self.deformation]
         self._images, self._strays, self._cbars = [], [], []
-        for ax, cmap, label, title in zip(
-            axes,
-            ("inferno", "viridis"),
-            ("T [C]", cb_label),
-            ("temperature (cyan: melt)", name),
-            strict=True,
+        for i, (ax, place, cmap, label, title) in enumerate(
+            zip(
+                axes,
+                cbar_places,
+                (temperature_cmap(self.bed), matplotlib.colormaps["viridis"]),
+                ("T [C]", cb_label),
+                ("temperature (cyan: melt)", name),
+                strict=True,
+            )
         ):
             im = ax.imshow(
                 np.ma.masked_all(self._shape),
@@ -219,7 +273,7 @@ class FramePainter:
                 extent=extent,
                 interpolation="nearest",  # one raster pixel per image pixel already
             )
-            self._cbars.append(fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03))
+            self._cbars.append(fig.colorbar(im, label=label, **place))
             self._images.append(im)
             # points too isolated to make material (a lone point, one thrown off) stay visible
             self._strays.append(
@@ -228,7 +282,8 @@ class FramePainter:
             ax.set_xlim(xmin, xmax)
             ax.set_ylim(ymin, ymax)
             ax.set_aspect("equal", adjustable="box")
-            ax.set_xlabel("x [um]")
+            if not (self.stacked and i == 0):  # stacked: the lower panel's x label serves both
+                ax.set_xlabel("x [um]")
             ax.set_ylabel("y [um]")
             ax.set_title(title, fontsize=10)
         self._axes, self._contour, self._fig = axes, None, fig

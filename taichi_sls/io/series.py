@@ -6,6 +6,8 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
+import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -88,22 +90,81 @@ class SeriesWriter:
 
 LOG_AXIS_DECADES = 2  # times spanning more decades than this are plotted on a log axis
 
+# A panel of the plot: one column (its label from SERIES_LABELS), or (y label, columns) drawn
+# together with a legend.
+Panel = str | tuple[str, tuple[str, ...]]
+# a bed's panels (jobs/bed_outcome.bed_monitors and the point monitors), three to a row
+BED_PANELS: tuple[Panel, ...] = (
+    "relative_density",
+    "molten_fraction",
+    "T_max_C",
+    "neck_median_um",
+    (
+        "contacts",
+        ("contacts", "contacts_melted_through", "contacts_molten", "contacts_fused"),
+    ),
+    "mean_top_um",
+)
+BED_PANELS_PER_ROW = 3
+SERIES_LABELS.update(
+    {
+        "relative_density": "relative density",
+        "molten_fraction": "molten fraction (of the mass)",
+        "neck_median_um": "median neck [um]",
+        "mean_top_um": "mean layer top [um]",
+        "contacts": "all",
+        "contacts_melted_through": "melted through",
+        "contacts_molten": "holding melt",
+        "contacts_fused": "fused",
+    }
+)
+START_LABEL = "value at t = 0"
+GROUP_STYLES = {"contacts": {"color": "0.6", "ls": "--"}}  # the total: a reference line
 
-def plot_series(csv_path: Path, png_path: Path, columns: list[str]) -> bool:
-    """Plot each of ``columns`` (those present) against ``t_s`` in microseconds, one panel each,
-    on a log axis when the times span more than LOG_AXIS_DECADES decades.
 
-    Returns False (and writes nothing) when there is nothing to plot: fewer than two rows, no
-    ``t_s`` column or none of ``columns`` present. Unparseable cells plot as gaps.
-    """
-    csv_path, png_path = Path(csv_path), Path(png_path)
-    if not csv_path.is_file():
+def plot_series(
+    csv_path: Path,
+    png_path: Path,
+    columns: Sequence[Panel],
+    per_row: int | None = None,
+    events: dict[str, float] | None = None,
+    start_lines: bool = False,
+) -> bool:
+    """Write :func:`series_figure` to ``png_path``; False (and nothing written) when it has
+    nothing to plot."""
+    fig = series_figure(csv_path, columns, per_row, events, start_lines)
+    if fig is None:
         return False
+    save_png(fig, Path(png_path), dpi=100)
+    return True
+
+
+def series_figure(
+    csv_path: Path,
+    columns: Sequence[Panel],
+    per_row: int | None = None,
+    events: dict[str, float] | None = None,
+    start_lines: bool = False,
+) -> Figure | None:
+    """Each of ``columns`` (those present; see Panel) against ``t_s`` in microseconds, one
+    panel each, ``per_row`` panels to a row (default: all in one), on a log axis when the times
+    span more than LOG_AXIS_DECADES decades; ``events`` (label: time in s) as dotted verticals;
+    with ``start_lines``, a one-column panel on a log axis shows its value at t = 0 (which the
+    axis cannot) as a dashed line. The figure's title says what the lines mark.
+
+    None when there is nothing to plot: fewer than two rows, no ``t_s`` column or none of
+    ``columns`` present. Unparseable cells plot as gaps.
+    """
+    csv_path = Path(csv_path)
+    if not csv_path.is_file():
+        return None
     with csv_path.open(newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
-    present = [c for c in columns if rows and c in rows[0]]
+    panels = [(SERIES_LABELS.get(c, c), (c,)) if isinstance(c, str) else c for c in columns]
+    present = [(label, [c for c in cols if rows and c in rows[0]]) for label, cols in panels]
+    present = [(label, cols) for label, cols in present if cols]
     if len(rows) < 2 or "t_s" not in rows[0] or not present:
-        return False
+        return None
 
     def col(name: str) -> np.ndarray:
         out = np.full(len(rows), np.nan)
@@ -116,19 +177,38 @@ def plot_series(csv_path: Path, png_path: Path, columns: list[str]) -> bool:
     pos = t_us[np.isfinite(t_us) & (t_us > 0)]
     # log-spaced rows (a laser case) span decades: a linear axis would squeeze the transient
     log_axis = pos.size > 1 and pos.max() / pos.min() > 10.0**LOG_AXIS_DECADES
-    fig = Figure(figsize=(4.2 * len(present), 3.2), layout="constrained")
+    ncols = min(per_row or len(present), len(present))
+    nrows = math.ceil(len(present) / ncols)
+    fig = Figure(figsize=(4.2 * ncols, 3.2 * nrows), layout="constrained")
     FigureCanvasAgg(fig)
-    for ax, name in zip(fig.subplots(1, len(present), squeeze=False)[0], present, strict=True):
-        if log_axis:
-            keep = t_us > 0  # t = 0 has no place on a log axis
-            ax.semilogx(t_us[keep], col(name)[keep], lw=1.2, marker=".", ms=3)
-        else:
-            ax.plot(t_us, col(name), lw=1.2)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax in axes[len(present) :]:
+        ax.set_visible(False)
+    keep = t_us > 0 if log_axis else np.isfinite(t_us)  # t = 0 has no place on a log axis
+    for ax, (label, cols) in zip(axes, present, strict=False):
+        for name in cols:
+            style = GROUP_STYLES.get(name, {}) if len(cols) > 1 else {}
+            line_label = SERIES_LABELS.get(name, name)
+            if log_axis:
+                ax.semilogx(t_us[keep], col(name)[keep], lw=1.2, marker=".", ms=3, **style)
+            else:
+                ax.plot(t_us[keep], col(name)[keep], lw=1.2, **style)
+            ax.lines[-1].set_label(line_label)
+        if start_lines and log_axis and len(cols) == 1 and t_us[0] == 0.0:
+            ax.axhline(col(cols[0])[0], color="0.6", lw=0.8, ls="--", label=START_LABEL)
+        for event, t_s in (events or {}).items():
+            ax.axvline(t_s * 1e6, color="0.4", lw=0.8, ls=":", label=event)
+        if len(cols) > 1:
+            ax.legend(fontsize=7)
         ax.set_xlabel("t [us]")
-        ax.set_ylabel(SERIES_LABELS.get(name, name))
+        ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
-    save_png(fig, png_path, dpi=100)
-    return True
+    notes = [f"dotted: {e} at {t_s * 1e6:.4g} us" for e, t_s in (events or {}).items()]
+    if start_lines and log_axis:
+        notes.append(f"dashed: the {START_LABEL}")
+    if notes:
+        fig.suptitle("; ".join(notes), fontsize=9)
+    return fig
 
 
 def read_series(path: str | Path) -> dict[str, np.ndarray]:

@@ -14,7 +14,7 @@ import numpy as np
 from .atomic import atomic_write_text
 from .frames import DEFORM_LABELS, FramePainter
 from .gif import write_gif
-from .series import MONITORED, SeriesWriter, plot_series
+from .series import BED_PANELS, BED_PANELS_PER_ROW, MONITORED, SeriesWriter, plot_series
 from .summary import write_summary
 from .vtu import VtuWriter
 
@@ -39,6 +39,7 @@ class OutputWriter:
         vtu: bool = False,
         dpi: int = 80,
         deformation: str = "displacement",
+        bed: bool = False,
     ) -> None:
         if deformation not in DEFORM_LABELS:
             raise ValueError(
@@ -50,6 +51,7 @@ class OutputWriter:
         self.out_dir = Path(out_dir)
         self.png, self.gif, self.vtu = png, gif, vtu
         self.deformation = deformation
+        self.bed = bed  # a powder layer: its own series (BED_PANELS) and the bed's frame colours
         self.dpi = int(dpi)
         self.frames_written = 0
         self.out_dir.mkdir(parents=True, exist_ok=True)
@@ -57,7 +59,7 @@ class OutputWriter:
         self._png_paths: dict[int, Path] = {}
         self.series = SeriesWriter(self.out_dir / "timeseries.csv")
         self._painter = FramePainter(
-            (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi
+            (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi, bed=bed
         )
         self._vtu = VtuWriter(self.out_dir)
 
@@ -126,8 +128,9 @@ class OutputWriter:
 
     # ----------------------------------------------------------------- end of run
 
-    def finish(self) -> None:
-        """Write animation.gif (if enabled) and timeseries.png; release the figure."""
+    def finish(self, events: dict[str, float] | None = None) -> None:
+        """Write animation.gif (if enabled) and timeseries.png (``events``, label: time in s,
+        marked on a bed's); release the figure."""
         self._painter.close()
         if self.gif:
             paths = [p for _, p in sorted(self._png_paths.items())]
@@ -135,5 +138,8 @@ class OutputWriter:
                 paths = sorted((self.out_dir / "frames").glob("frame_*.png"))
             if paths:
                 write_gif(paths, self.out_dir / "animation.gif")
-        columns = [c for c in MONITORED if c in self.series.header]
-        plot_series(self.out_dir / "timeseries.csv", self.out_dir / "timeseries.png", columns)
+        csv_path, png_path = self.out_dir / "timeseries.csv", self.out_dir / "timeseries.png"
+        if self.bed:
+            plot_series(csv_path, png_path, BED_PANELS, BED_PANELS_PER_ROW, events, True)
+        else:
+            plot_series(csv_path, png_path, [c for c in MONITORED if c in self.series.header])

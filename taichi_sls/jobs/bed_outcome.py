@@ -161,6 +161,40 @@ def layer_density(sim: Simulation) -> dict[str, float]:
     )
 
 
+# the bed's columns of the time series (one value per output frame), in the order plotted
+BED_SERIES = (
+    "relative_density",
+    "mean_top_um",
+    "neck_median_um",
+    "contacts",
+    "contacts_melted_through",
+    "contacts_molten",
+    "contacts_fused",
+    "fused_fraction",
+)
+
+
+def bed_monitors(sim: Simulation, rows: list[dict[str, float]]) -> dict[str, float]:
+    """The bed's quantities at this output frame, from the measures of its outcome: the layer's
+    relative density and mean top (layer_density), the median of the contacts' necks now, and
+    how many contacts have melted through, hold melt now and are fused by the verdict's rule
+    as it reads at this frame (a contact counts as fused once it has refrozen)."""
+    d = layer_density(sim)
+    n = len(rows)
+    fused = sum(int(r["fused"]) for r in rows)
+    necks = np.array([r["neck_final_um"] for r in rows], dtype=float)
+    return {
+        "relative_density": d["relative_density"],
+        "mean_top_um": d["mean_top_m"] * 1e6,
+        "neck_median_um": _quartiles(necks)["median"],
+        "contacts": n,
+        "contacts_melted_through": sum(int(r["melted_through"]) for r in rows),
+        "contacts_molten": sum(1 - int(r["refrozen"]) for r in rows),
+        "contacts_fused": fused,
+        "fused_fraction": fused / n if n else math.nan,
+    }
+
+
 def _quartiles(v: np.ndarray) -> dict[str, float]:
     v = v[np.isfinite(v)]
     if len(v) == 0:

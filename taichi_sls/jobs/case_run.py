@@ -5,6 +5,8 @@ Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``
 ``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
 ``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed) adds
 ``contacts.csv`` and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py),
+the bed's own columns of the time series and plots (the layer's density, melt and contacts
+over time: io/series.BED_PANELS; the contacts map and necks: io/bed_outcome_plot.py),
 its verdict per contact, and ``layer.npz``, its points at the end (``bed.previous_layer`` of a
 next layer). Every file is written atomically; an interrupted or
 failed run still leaves valid files and a summary that says so.
@@ -23,6 +25,7 @@ from typing import Any
 
 from ..config import Case, case_to_toml
 from ..config.layer_file import CARRIED_STATE
+from ..io.bed_outcome_plot import plot_bed_outcome
 from ..io.contacts_plot import plot_contacts
 from ..io.contacts_table import read_contacts, write_contacts
 from ..io.layer_output import write_layer
@@ -33,7 +36,7 @@ from ..physics.materials import KELVIN
 from ..solver.guard import SimulationError
 from ..solver.scene import Scene
 from ..solver.simulation import Simulation
-from .bed_outcome import ContactHistory, bed_summary, describe_bed, is_bed
+from .bed_outcome import ContactHistory, bed_monitors, bed_summary, describe_bed, is_bed
 from .outcome import NeckHistory, describe, neck_region, outcome
 from .progress import Progress
 from .schedule import SETTLED_FRAMES, frame_steps, reached, settled, step_towards
@@ -62,6 +65,7 @@ def _writer(case: Case, out_dir: Path) -> OutputWriter:
         vtu=o.vtu,
         dpi=o.dpi,
         deformation=o.deformation,
+        bed=is_bed(case),
     )
 
 
@@ -138,11 +142,13 @@ def run_case(
 
     def frame(index: int, guard: bool = True) -> dict[str, float]:
         mon = sim.monitors(guard=guard)
-        writer.row(mon)
-        history.add(mon)
         if bed is not None and guard:  # not on the blown-up state of a failed run
             bed.add(sim)
-            write_contacts(out_dir / "contacts.csv", bed.rows(sim))
+            rows = bed.rows(sim)
+            write_contacts(out_dir / "contacts.csv", rows)
+            mon.update(bed_monitors(sim, rows))  # the bed's series (timeseries.png)
+        writer.row(mon)
+        history.add(mon)
         snap = sim.snapshot(full=writer.vtu)
         deform = snap[
             "displacement_um" if case.output.deformation == "displacement" else "plastic_strain"
@@ -262,6 +268,15 @@ def run_case(
                 write_contacts(out_dir / "contacts.csv", rows)
                 summary["bed"] = bed_summary(sim, rows, bed.density_initial)
                 plot_contacts(out_dir, rows, pt.x.to_numpy() * 1e6)
+                density = summary["bed"]["relative_density"]
+                plot_bed_outcome(
+                    out_dir,
+                    rows,
+                    pt.x.to_numpy() * 1e6,
+                    time_molten=pt.time_molten.to_numpy(),
+                    density=(density["initial"], density["final"]),
+                    neck_growth=case.fusion.neck_growth,
+                )
                 if summary["status"] != "failed":  # the layer a next one is deposited on
                     write_layer_file(out_dir / LAYER_FILE, sim, summary["status"])
                     summary["layer_file"] = LAYER_FILE
@@ -287,12 +302,20 @@ def run_case(
             warnings=list(dict.fromkeys(warnings)),
         )
         writer.summary(summary)
-        writer.finish()
+        writer.finish(beam_off(case) if bed is not None else None)
         try:
-            plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
+            if bed is None:  # a bed's outcome.png is drawn with its contacts above
+                plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
         except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
             print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)
     return summary
+
+
+def beam_off(case: Case) -> dict[str, float]:
+    """When the last laser stops heating (switched off or scanned past its end), as an event of
+    the bed's time series."""
+    off = case.lasers_off_s()
+    return {"beam off": off} if off > 0.0 else {}
 
 
 def write_layer_file(path: Path, sim: Simulation, status: str) -> None:

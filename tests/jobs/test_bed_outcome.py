@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 from helpers import PAPER_SCENE, deep_update, make_case
 
+from taichi_sls.io.series import read_series
 from taichi_sls.jobs.bed_layer import melt_extent, relative_density
-from taichi_sls.jobs.bed_outcome import contact_geometry, neck_regions
+from taichi_sls.jobs.bed_outcome import BED_SERIES, contact_geometry, neck_regions
 from taichi_sls.jobs.case_run import run_case
 from taichi_sls.jobs.outcome import neck_region
 from taichi_sls.solver.contacts import fillet, point_colour
@@ -123,6 +124,31 @@ def test_melt_track_and_verdict_with_and_without_laser(runs):
         if int(r["melted_through"]):
             assert math.isfinite(float(r["neck_melt_um"]))
     assert (runs["laser"][1] / "contacts.png").stat().st_size < 300_000
+
+
+def test_the_time_series_holds_the_beds_quantities_at_every_frame(runs):
+    """timeseries.csv has the bed's columns at every frame, the same measures as the outcome:
+    the density at the first and last frames is the bed record's before and after, the last
+    frame's median neck and contact counts those of the contacts table; the plots are the
+    bed's (tests/io/test_bed_plots.py checks what they hold)."""
+    for name in ("laser", "dark"):
+        folder = runs[name][1]
+        s, bed, rows = read_series(folder / "timeseries.csv"), _bed(folder), _table(folder)
+        assert len(s["t_s"]) == 4  # frame 0 and the three output frames
+        for col in BED_SERIES:
+            assert np.isfinite(s[col]).all(), (name, col)
+        d = bed["relative_density"]
+        assert s["relative_density"][0] == pytest.approx(d["initial"], rel=1e-12)
+        assert s["relative_density"][-1] == pytest.approx(d["final"], rel=1e-12)
+        assert s["mean_top_um"][-1] == pytest.approx(d["mean_top_final_um"], rel=1e-12)
+        assert s["neck_median_um"][-1] == pytest.approx(bed["neck_final_um"]["median"])
+        assert (s["contacts"] == len(TANGENT)).all()
+        assert s["contacts_fused"][-1] == bed["fused"]
+        assert s["contacts_melted_through"][-1] == bed["melted_through"]
+        assert s["contacts_molten"][-1] == sum(1 - int(r["refrozen"]) for r in rows)
+        assert (folder / "timeseries.png").is_file() and (folder / "outcome.png").is_file()
+    heated = read_series(runs["laser"][1] / "timeseries.csv")
+    assert heated["contacts_molten"][-1] > 0 and heated["molten_fraction"][-1] > 0
 
 
 def test_a_resumed_bed_run_keeps_its_contact_history(runs, tmp_path):

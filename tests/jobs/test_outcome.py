@@ -4,10 +4,12 @@ and small runs that stop by themselves."""
 import json
 import math
 
+import imageio.v3 as iio
 import numpy as np
 import pytest
 from helpers import PAPER_SCENE, deep_update, make_case
 
+from taichi_sls.io.series import read_series
 from taichi_sls.jobs.case_run import run_case
 from taichi_sls.jobs.outcome import NeckHistory, describe, outcome
 from taichi_sls.jobs.schedule import frame_steps, settled
@@ -186,6 +188,10 @@ def test_a_warmed_pair_is_not_fused_and_stops_soon_after_the_beam(tmp_path):
     assert o["T_peak_C"] < 175.0  # below T_m: the beam only warms
     assert s["simulated_s"] < 0.05  # it stops by itself, long before max_s
     assert (tmp_path / "warm" / "outcome.png").is_file()
+    # a pair keeps its pictures: the contact line and peak temperature side by side (the bed's
+    # series and panels are a bed's only: tests/io/test_bed_plots.py)
+    assert "relative_density" not in read_series(tmp_path / "warm" / "timeseries.csv")
+    assert iio.imread(tmp_path / "warm" / "timeseries.png").shape[:2] == (320, 840)
 
 
 def test_a_molten_pair_stops_when_everything_is_below_T_c(tmp_path):
