@@ -159,15 +159,16 @@ def in_passes(
     scale,
 ):
     """``body(cfg, nd, target, scale, i, j)`` for every (i, j) in ``active(box, shrink)``,
-    where each (i, j) writes nodes less than ``stride`` away along each axis. Serial layout: one
-    loop. The parallel layouts: tiles of stride x stride, coloured in four by the parity of
-    their tile coordinates as in the blocks layout (solver/blocks.py); four passes, one per
-    colour, each tile's (i, j) in order by one thread. Two tiles of one colour lie a tile apart,
-    so no two threads write one node: the blocks layout's plain adds do not race, and every
-    node takes its terms in one order whatever the threads (a run repeats bit for bit)."""
+    where each (i, j) writes nodes less than ``stride`` away along each axis. The blocks layout
+    (plain adds): tiles of stride x stride, coloured in four by the parity of their tile
+    coordinates as its blocks are (solver/blocks.py); four passes, one per colour, each tile's
+    (i, j) in order by one thread. Two tiles of one colour lie a tile apart, so no two threads
+    write one node at once, and every node takes its terms in one order whatever the threads (a
+    run repeats bit for bit). The other layouts: one loop (serial, or parallel with atomic adds,
+    whose order the GPU's atomic P2G leaves open anyway)."""
     b = box[None]
     i0, j0, i1, j1 = b[0], b[1], b[2] - shrink, b[3] - shrink
-    if ti.static(cfg.parallel):
+    if ti.static(cfg.race_free):
         n_ti = (i1 - i0 + stride - 1) // stride
         n_tj = (j1 - j0 + stride - 1) // stride
         for c in ti.static(range(4)):

@@ -181,14 +181,14 @@ def wall_heat(cfg: ti.template(), nd: ti.template(), I, dt):
 
 @ti.func
 def grid_heat(cfg: ti.template(), nd: ti.template(), sc: ti.template(), I, dt):
-    """Node I's temperature change over dt; a fixed node's heat goes to the walls' total here in
-    the serial layout, by :func:`wall_heat` in order in the parallel ones (a float sum that
-    threads take in any order would not repeat bit for bit)."""
+    """Node I's temperature change over dt; a fixed node's heat goes to the walls' total here,
+    but in the blocks layout by :func:`wall_heat` in node order (a float sum that threads take
+    in any order would not repeat bit for bit)."""
     dT = 0.0
     if nd.heat_capacity[I] > 0.0:
         fixed, Tw = fixed_temperature(cfg, I)
         if fixed:
-            if ti.static(not cfg.parallel):
+            if ti.static(not cfg.race_free):
                 sc.heat_out[None] += dt * nd.heat_rate[I]
         else:
             dT = dt * nd.heat_rate[I] / nd.heat_capacity[I]
