@@ -21,6 +21,7 @@ from .layer_file import read_layer
 from .materials import Material
 from .model import Model, Pair
 from .numerics import Solver, Time
+from .overlap import check_overlaps
 from .sections import (
     Boundary,
     CaseInfo,
@@ -175,6 +176,7 @@ class Case(Model):
     @model_validator(mode="after")
     def _cross_checks(self) -> Case:
         """What a field type alone cannot express."""
+        check_overlaps(self.bodies, self.contact.allow_overlap)  # the case's own, before the bed
         self._expand_bed()
         if not self.bodies:
             raise CaseError(f"bodies = []: {NO_BODIES}")

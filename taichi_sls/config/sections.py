@@ -128,6 +128,12 @@ class Contact(Model):
         "radius R the neck is 2 (sqrt(rho^2 + 2 R rho) - rho): 8 um at rho = 0.5 um (the "
         "paper's neck, below the grid), 10.8 um at 1 um, 14.3 um at 2 um",
     )
+    allow_overlap: bool = Field(
+        False,
+        description="true: [[bodies]] discs may overlap (the overlap's points go to the first "
+        "body that holds them); false: two discs overlapping beyond round-off are an error "
+        "naming both and the depth",
+    )
     neck_section: Literal["column", "centres"] = Field(
         "column",
         description="column: the narrowest vertical node column between bodies 0 and 1, holes "

@@ -119,26 +119,73 @@ def segment_force(cfg: ti.template(), nd: ti.template(), a, b, gamma):
 def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()):
     """floor_mode = "spread": node i keeps m_i / max(m_i, floor) of its surface force and hands
     the rest to its 3x3 neighbours in proportion to their mass. The total force is kept
-    (momentum); the torque changes by the rest times at most sqrt(2) h."""
-    for I in ti.grouped(ti.ndrange(*active(box))):
-        f = nd.surface_force[I]
-        m = nd.mass[I]
-        if m >= cfg.se.floor_mass:
-            scatter_add(cfg, nd.force, I, f)
-        elif f.norm_sqr() > 0.0:
-            M = 0.0
+    (momentum); the torque changes by the rest times at most sqrt(2) h. A node writes its 3x3
+    neighbours: in the parallel layouts nodes three apart at a time (:func:`in_passes`)."""
+    in_passes(cfg, box, 0, 3, _spread_node, nd, nd, 0.0)
+
+
+@ti.func
+def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), scale, i, j):
+    I = ti.Vector([i, j])
+    f = nd.surface_force[I]
+    m = nd.mass[I]
+    if m >= cfg.se.floor_mass:
+        scatter_add(cfg, nd.force, I, f)
+    elif f.norm_sqr() > 0.0:
+        M = 0.0
+        for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
+            if ti.static(o[0] != 0 or o[1] != 0):
+                M += nd.mass[I + o]
+        keep = m / cfg.se.floor_mass
+        if M <= 0.0:
+            keep = 1.0
+        scatter_add(cfg, nd.force, I, keep * f)
+        if M > 0.0:
+            rest = (1.0 - keep) / M * f
             for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
                 if ti.static(o[0] != 0 or o[1] != 0):
-                    M += nd.mass[I + o]
-            keep = m / cfg.se.floor_mass
-            if M <= 0.0:
-                keep = 1.0
-            scatter_add(cfg, nd.force, I, keep * f)
-            if M > 0.0:
-                rest = (1.0 - keep) / M * f
-                for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
-                    if ti.static(o[0] != 0 or o[1] != 0):
-                        scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
+                    scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
+
+
+@ti.func
+def in_passes(
+    cfg: ti.template(),
+    box: ti.template(),
+    shrink: ti.template(),
+    stride: ti.template(),
+    body: ti.template(),
+    nd: ti.template(),
+    target: ti.template(),
+    scale,
+):
+    """``body(cfg, nd, target, scale, i, j)`` for every (i, j) in ``active(box, shrink)``,
+    where each (i, j) writes nodes less than ``stride`` away along each axis. The blocks layout
+    (plain adds): tiles of stride x stride, coloured in four by the parity of their tile
+    coordinates as its blocks are (solver/blocks.py); four passes, one per colour, each tile's
+    (i, j) in order by one thread. Two tiles of one colour lie a tile apart, so no two threads
+    write one node at once, and every node takes its terms in one order whatever the threads (a
+    run repeats bit for bit). The other layouts: one loop (serial, or parallel with atomic adds,
+    whose order the GPU's atomic P2G leaves open anyway)."""
+    b = box[None]
+    i0, j0, i1, j1 = b[0], b[1], b[2] - shrink, b[3] - shrink
+    if ti.static(cfg.race_free):
+        n_ti = (i1 - i0 + stride - 1) // stride
+        n_tj = (j1 - j0 + stride - 1) // stride
+        for c in ti.static(range(4)):
+            ci, cj = ti.static(c % 2, c // 2)
+            for u, v in ti.ndrange(
+                ti.max(0, (n_ti - ci + 1) // 2), ti.max(0, (n_tj - cj + 1) // 2)
+            ):
+                lo_i = i0 + stride * (ci + 2 * u)
+                lo_j = j0 + stride * (cj + 2 * v)
+                for k in range(stride * stride):
+                    i = lo_i + k // stride
+                    j = lo_j + k % stride
+                    if i < i1 and j < j1:
+                        body(cfg, nd, target, scale, i, j)
+    else:
+        for i, j in ti.ndrange((i0, i1), (j0, j1)):
+            body(cfg, nd, target, scale, i, j)
 
 
 @ti.func
@@ -151,8 +198,16 @@ def outline_segments(
     scale,
 ):
     """visit(cfg, target, a, b, scale) for every segment a-b of the c = 1/2 contour of
-    nd.colour, cell by cell (marching squares)."""
-    for i, j in ti.ndrange(*active(box, 1)):
+    nd.colour, cell by cell (marching squares). A Gauss point in cell i has its stencil on
+    nodes i-1..i+2: cells four apart never write one node (:func:`in_passes`)."""
+    in_passes(cfg, box, 1, 4, ti.static(_cell_outline(visit)), nd, target, scale)
+
+
+def _cell_outline(visit):
+    """The body of :func:`outline_segments` for cell (i, j), with its arguments bound."""
+
+    @ti.func
+    def body(cfg: ti.template(), nd: ti.template(), target: ti.template(), scale, i, j):
         if i > 0 and j > 0 and i < cfg.nx - 2 and j < cfg.ny - 2:
             f = C_INTERFACE - ti.Vector(
                 [nd.colour[i, j], nd.colour[i + 1, j], nd.colour[i + 1, j + 1], nd.colour[i, j + 1]]
@@ -164,6 +219,8 @@ def outline_segments(
                     a = ti.Vector([ends[4 * k], ends[4 * k + 1]])
                     b = ti.Vector([ends[4 * k + 2], ends[4 * k + 3]])
                     visit(cfg, target, a, b, scale)
+
+    return body
 
 
 @ti.func

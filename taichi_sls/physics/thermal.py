@@ -169,12 +169,27 @@ def p2g_heat_flux(
 
 
 @ti.func
+def wall_heat(cfg: ti.template(), nd: ti.template(), I, dt):
+    """The heat (J per depth) that fixed node I passes to the walls over dt (0 if not fixed)."""
+    q = 0.0
+    if nd.heat_capacity[I] > 0.0:
+        fixed, Tw = fixed_temperature(cfg, I)
+        if fixed:
+            q = dt * nd.heat_rate[I]
+    return q
+
+
+@ti.func
 def grid_heat(cfg: ti.template(), nd: ti.template(), sc: ti.template(), I, dt):
+    """Node I's temperature change over dt; a fixed node's heat goes to the walls' total here,
+    but in the blocks layout by :func:`wall_heat` in node order (a float sum that threads take
+    in any order would not repeat bit for bit)."""
     dT = 0.0
     if nd.heat_capacity[I] > 0.0:
         fixed, Tw = fixed_temperature(cfg, I)
         if fixed:
-            sc.heat_out[None] += dt * nd.heat_rate[I]
+            if ti.static(not cfg.race_free):
+                sc.heat_out[None] += dt * nd.heat_rate[I]
         else:
             dT = dt * nd.heat_rate[I] / nd.heat_capacity[I]
     nd.dT[I] = dT
