@@ -58,3 +58,20 @@ def guard_message(sim, frames: int = 1, steps: int = 0) -> str | None:
         except SimulationError as e:
             return str(e)
     return None
+
+
+_SHARED: dict = {}
+
+
+def shared(key: str, build):
+    """``build()`` once while the Taichi program it ran in lives: a Simulation whose kernels
+    several tests use compiles them once (every ``ti.init``, so every new Simulation, sends each
+    kernel through Taichi's front end again). A test between them that starts Taichi afresh
+    frees the fields, and the next call builds anew. Callers restore what a test changes."""
+    from taichi.lang import impl
+
+    hit = _SHARED.get(key)
+    if hit is None or hit[0] is not impl.get_runtime():
+        value = build()
+        hit = _SHARED[key] = (impl.get_runtime(), value)
+    return hit[1]
