@@ -1,6 +1,8 @@
 """Shared test helpers: small cases built from dicts, compiled without Taichi's advanced
 optimisation (about 10x faster to compile; the tests measure accuracy, not speed)."""
 
+import functools
+
 from taichi_sls.config import case_from_dict, deep_update
 
 PAPER_SCENE = {
@@ -75,3 +77,16 @@ def shared(key: str, build):
         value = build()
         hit = _SHARED[key] = (impl.get_runtime(), value)
     return hit[1]
+
+
+@functools.cache
+def explicit_coarse_peak_C() -> float:
+    """The peak temperature (C) of the coarse 25 W pair's explicit run to 0.1 ms (its pulse ends
+    at 20 us), which implicit runs of the case are held to: run once per test process. It
+    starts Taichi afresh: call it after the test's own simulation is read."""
+    from taichi_sls.config import load_case
+    from taichi_sls.solver.simulation import Simulation
+
+    ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
+    ref.advance(round(1e-4 / ref.dt))
+    return ref.monitors()["T_peak_C"]
