@@ -1,6 +1,8 @@
 """Shared test helpers: small cases built from dicts, compiled without Taichi's advanced
 optimisation (about 10x faster to compile; the tests measure accuracy, not speed)."""
 
+import functools
+
 from taichi_sls.config import case_from_dict, deep_update
 
 PAPER_SCENE = {
@@ -58,3 +60,33 @@ def guard_message(sim, frames: int = 1, steps: int = 0) -> str | None:
         except SimulationError as e:
             return str(e)
     return None
+
+
+_SHARED: dict = {}
+
+
+def shared(key: str, build):
+    """``build()`` once while the Taichi program it ran in lives: a Simulation whose kernels
+    several tests use compiles them once (every ``ti.init``, so every new Simulation, sends each
+    kernel through Taichi's front end again). A test between them that starts Taichi afresh
+    frees the fields, and the next call builds anew. Callers restore what a test changes."""
+    from taichi.lang import impl
+
+    hit = _SHARED.get(key)
+    if hit is None or hit[0] is not impl.get_runtime():
+        value = build()
+        hit = _SHARED[key] = (impl.get_runtime(), value)
+    return hit[1]
+
+
+@functools.cache
+def explicit_coarse_peak_C() -> float:
+    """The peak temperature (C) of the coarse 25 W pair's explicit run to 0.1 ms (its pulse ends
+    at 20 us), which implicit runs of the case are held to: run once per test process. It
+    starts Taichi afresh: call it after the test's own simulation is read."""
+    from taichi_sls.config import load_case
+    from taichi_sls.solver.simulation import Simulation
+
+    ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
+    ref.advance(round(1e-4 / ref.dt))
+    return ref.monitors()["T_peak_C"]

@@ -43,6 +43,9 @@ def test_the_hybrid_neck_is_the_explicit_one_at_a_fraction_of_the_steps(explicit
     temperature are the explicit run's within 1 % (the peak falls in the explicit phase:
     equal), in under a fifth of its steps (measured 1,382 of 9,888; neck -0.1 %)."""
     hybrid = Simulation(load_case("power25W_coarse", HYBRID))
+    # the adaptive step's smallest is the explicit one (dt_min_s = "auto" with the floor the
+    # hybrid passes: tests/solver/test_adaptive.py)
+    assert hybrid.adaptive.controls.dt_min == hybrid.dt
     hybrid.advance_to(1e-3)
     assert not hybrid.explicit_now and hybrid.handover.handbacks == 0
     assert 20e-6 <= hybrid.handover.at_s < 1e-3
