@@ -27,7 +27,8 @@ Totals (``totals``): the monitors' reductions over the points (solver/monitor.py
 """
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix

@@ -33,7 +33,8 @@ conjugate gradients over the next iterations and steps. The matrix is symmetric 
 from dataclasses import dataclass
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..config import Case
 from ..physics.codes import SurfaceMethod
