@@ -37,6 +37,8 @@ from .time_step import (
     time_step_limits,
 )
 
+OFFLINE_CACHE_BYTES = 2**30  # ~5 MB a case's kernels
+
 
 def init_taichi(
     arch: str = "cpu",
@@ -55,6 +57,10 @@ def init_taichi(
         arch=ti.cpu if arch == "cpu" else ti.gpu,
         default_fp=ti.f64 if precision == "f64" else ti.f32,
         offline_cache=True,
+        # Taichi's default keeps 100 MB and drops the least recently used quarter beyond it: a
+        # machine that runs a few cases and the suite passes that, and a "warm" start then
+        # compiles a part of its kernels again (docs/compile.md)
+        offline_cache_max_size_of_files=OFFLINE_CACHE_BYTES,
         advanced_optimization=optimize,
         fast_math=fast_math,
         log_level=ti.ERROR,
