@@ -2,7 +2,8 @@
 
     run CASE         run a case file (or a bundled case by name) with every output
     sweep SWEEP      a parameter sweep on Dask
-    bench STUDY      speed, cost, implicit (both integrators side by side), hold (a melt that
+    bench STUDY      speed, compile (each bundled case's, cold and warm), cost, implicit (both
+                     integrators side by side), hold (a melt that
                      sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
                      neck (the melted-pair study), refinement (the paper's cases under grid and
                      dt refinement)
@@ -132,6 +133,7 @@ def case_command(args: argparse.Namespace) -> int:
 def parser() -> argparse.ArgumentParser:
     from .studies import (
         accuracy,
+        compile_bench,
         cost_error,
         implicit_bench,
         neck_study,
@@ -153,12 +155,13 @@ def parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub)
     bench = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, cost, implicit, hold, accuracy, paper, neck, "
-        "refinement",
+        help="benchmarks and studies: speed, compile, cost, implicit, hold, accuracy, paper, "
+        "neck, refinement",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
         speed,
+        compile_bench,
         cost_error,
         implicit_bench,
         sinter_hold,

@@ -21,6 +21,7 @@ from collections import deque
 import numpy as np
 
 from ..config import Case
+from ..solver import struct_copy
 from ..solver.guard import SimulationError
 from ..solver.params import laser_arrays
 from ..solver.simulation import Simulation
@@ -42,7 +43,7 @@ def lasers_absorb(sim: Simulation, absorb: bool) -> None:
     beams = laser_arrays(sim.case)
     if not absorb:
         beams["amplitude_W_m3"] = np.zeros_like(beams["amplitude_W_m3"])
-    sim.state.lasers.from_numpy(beams)
+    struct_copy.from_numpy(sim.state.lasers, beams)
 
 
 def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, float]:

@@ -13,7 +13,7 @@ Perzyna map (eqs. 40-45) on its deviator, backward Euler (zero yield: a Maxwell 
 
 import math
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .codes import Strain, StressForm, StressReading
 from .materials import lerp_phase, viscosity

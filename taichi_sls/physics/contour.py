@@ -1,7 +1,7 @@
 """Marching squares in one cell: the outline of a node field where it crosses zero, shared by the
 CSF level set (its redistancing) and the surface-energy force (its outline)."""
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 
 @ti.func

@@ -7,7 +7,7 @@ ghost nodes beyond the walls enter grad m only. Level set: physics/level_set.py;
 physics/curvature.py.
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .codes import NodeFlag
 from .curvature import curvature, extend_and_smooth

@@ -15,7 +15,8 @@ matrix, the list of interface nodes).
 """
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from .codes import NodeFlag
 from .grid import active

@@ -1,6 +1,6 @@
 """Node positions, the active region of the grid, and the capillary coefficient in time."""
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 
 @ti.func

@@ -7,7 +7,7 @@ metres): ``on_s``, ``off_s``, ``x_start_m``, ``speed_m_s``, ``x_end_m``, ``top_m
 depth factor, times rho for the printed per-mass reading) and ``depth_sign`` (+1 decay, -1 the
 printed sign)."""
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 LASER_MEMBERS = (
     "on_s",

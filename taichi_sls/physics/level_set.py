@@ -14,7 +14,7 @@ Arguments: ``cfg`` the step's configuration, ``box`` the active region, ``nd`` t
 the contour segments (``seg.ends`` up to two per cell, ``seg.count``).
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .contour import cell_segments
 from .grid import active, scatter_min

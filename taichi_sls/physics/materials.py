@@ -25,7 +25,7 @@ xi_s, H(T, update(T, xi_s)) rises monotonically in T (crystallisation branch, fr
 melting branch), so the inverse T(H; xi_s) is again closed form and unique.
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .codes import ViscosityModel
 

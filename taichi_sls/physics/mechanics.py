@@ -26,7 +26,7 @@ stays the default.
 ``nd`` the nodes (struct fields, solver/fields.py).
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .codes import Transfer, WallMechanical
 from .grid import node_x, scatter_add

@@ -5,7 +5,7 @@ closer than h + l_p. With node spacing h that is at most three nodes per axis, s
 ``base = round(x/h) - 1`` (eqs. 8-9 with N_i the uGIMP function).
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 # Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
 # surface tension and output are 2D (plane strain) for now.

@@ -23,7 +23,7 @@ of it: the matrix lives on the grid as ``K[I, I_j - I_i + 2, a, b]`` and solver/
 gathers it into a sparse matrix.
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .shape import STENCIL, node_weight, stencil
 from .surface_energy import GAUSS, outline_segments

@@ -34,7 +34,7 @@ the nodes (``mass``, ``volume``, ``colour``, ``surface_force``, and ``force`` th
 
 import math
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .contour import cell_segments
 from .grid import active, ramped_gamma, scatter_add

@@ -38,7 +38,7 @@ functions return what a point adds to the run's totals (laser energy, heat out);
 accumulates them as its layout needs.
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .grid import scatter_add
 from .laser import laser_source

@@ -23,7 +23,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..config import Case
 from . import checkpoint

@@ -17,7 +17,8 @@ flags it, and the simulation sorts the points again before the next step.
 from __future__ import annotations
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 SIDE = 12  # cells per block side
 MARGIN = 3  # cells a point may leave its block by (the stencils reach 3 nodes: SIDE > 2 MARGIN + 4)

@@ -19,7 +19,7 @@ keeps the halves' state (first order there; counted in ``kept``, the main job's 
 ``extrapolation_kept_points``).
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from . import checkpoint
 from .adaptive import copy_points

@@ -27,13 +27,15 @@ Totals (``totals``): the monitors' reductions over the points (solver/monitor.py
 """
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix
 from ..physics.laser import laser_struct
 from ..physics.materials import KELVIN, enthalpy, material_struct, solid_fraction
 from ..physics.stiffness import WIDTH
+from . import struct_copy
 from .scene import Scene
 from .step_config import StepConfig
 
@@ -201,7 +203,7 @@ class State:
 
     def _fill(self, materials: dict[str, np.ndarray], lasers: dict[str, np.ndarray]) -> None:
         cfg, sc = self.cfg, self.scene
-        self.materials.from_numpy(materials)
+        struct_copy.from_numpy(self.materials, materials)
         rho = materials["density_kg_m3"][sc.material]
         pt = ti.static(self.points)
         pt.x.from_numpy(sc.x)
@@ -218,7 +220,7 @@ class State:
         full = [0, 0, cfg.nx, cfg.ny]
         self.box[None] = [cfg.nx, cfg.ny, 0, 0] if cfg.active_region else full
         if cfg.n_lasers:
-            self.lasers.from_numpy(lasers)
+            struct_copy.from_numpy(self.lasers, lasers)
         self.scalars.t[None] = 0.0
         self.scalars.T_peak[None] = float(np.max(sc.T0_C + KELVIN))
         for k in WATCHED:

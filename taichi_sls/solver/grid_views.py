@@ -2,7 +2,7 @@
 verification: the level set of eq. 21, the surface-energy colour, and the step's stages through
 the surface force (solver/step.py)."""
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from ..physics.grid import active
 from ..physics.level_set import level_set, scatter_level_set

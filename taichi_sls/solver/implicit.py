@@ -33,7 +33,8 @@ conjugate gradients over the next iterations and steps. The matrix is symmetric 
 from dataclasses import dataclass
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..config import Case
 from ..physics.codes import SurfaceMethod
@@ -48,7 +49,7 @@ from ..physics.stiffness import (
     scatter_point_tangent,
     stencil_offset,
 )
-from . import checkpoint
+from . import checkpoint, struct_copy
 from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
@@ -240,7 +241,7 @@ class ImplicitStepper:
         seconds of compilation inside its stepping time."""
         st = self.st
         saved = checkpoint.capture(st)
-        scalars = st.scalars.to_numpy()
+        scalars = struct_copy.to_numpy(st.scalars)
         sort = int(st.blocks.needs_sort[None]) if st.blocks is not None else 0
         st.scalars.dt[None] = WARM_UP_FRACTION * float(scalars["dt"])
         st.scalars.dt_heat[None] = WARM_UP_FRACTION * float(scalars["dt_heat"])
@@ -252,7 +253,7 @@ class ImplicitStepper:
         except SimulationError:
             pass  # compiled as far as it went; the run's own step reports a failure
         checkpoint.restore(st, saved)
-        st.scalars.from_numpy(scalars)
+        struct_copy.from_numpy(st.scalars, scalars)
         if st.blocks is not None:
             st.blocks.needs_sort[None] = sort
         init_box(st)

@@ -23,7 +23,8 @@ capacity varies.
 
 import numpy as np
 import scipy.sparse as sp
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..config import Case
 from ..physics.codes import HeatNode

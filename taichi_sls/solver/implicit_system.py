@@ -8,7 +8,8 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..physics.stiffness import REACH, WIDTH, stencil_offset
 

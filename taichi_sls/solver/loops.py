@@ -5,7 +5,7 @@ sorted points (solver/blocks.py), scatters in four colour passes, with per-block
 A stage hands a point body ``body(st, p, blk, heat, geom)`` to :func:`point_loop`; ``blk`` is
 the point's block (0 outside the blocks layout)."""
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from .blocks import MARGIN, SIDE
 from .step_config import Layout

@@ -16,7 +16,8 @@ The material is {phi < 0} of eq. 21 (the paper's Fig. 4, with the point radius r
 from enum import IntEnum
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..physics.materials import KELVIN
 from .fields import State

@@ -26,7 +26,7 @@ thousand points. Parallel (GPU, large scenes): one kernel call per step, every s
 loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
 """
 
-import taichi as ti
+from taichi_sls.backend import ti
 
 from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step

@@ -7,7 +7,8 @@ the physics and of uGIMP.
 """
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 
 @ti.data_oriented

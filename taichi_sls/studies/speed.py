@@ -17,7 +17,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-import taichi as ti
+
+from taichi_sls.backend import ti
 
 from ..config import Case, apply_override, bundled_case, case_from_dict, case_to_dict, load_case
 from ..config.loading import add_set_argument

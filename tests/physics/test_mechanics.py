@@ -4,9 +4,9 @@ import math
 
 import numpy as np
 import pytest
-import taichi as ti
 from helpers import deep_update, make_case, material_field
 
+from taichi_sls.backend import ti
 from taichi_sls.config import Material
 from taichi_sls.physics.codes import StressReading
 from taichi_sls.physics.constitutive import embed3, perzyna_update

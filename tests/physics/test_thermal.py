@@ -4,9 +4,9 @@ import math
 
 import numpy as np
 import pytest
-import taichi as ti
 from helpers import PAPER_SCENE, deep_update, make_case, material_field
 
+from taichi_sls.backend import ti
 from taichi_sls.config import Material
 from taichi_sls.physics.materials import (
     KELVIN,

@@ -4,8 +4,8 @@ import csv
 
 import numpy as np
 import pytest
-import taichi as ti
 
+from taichi_sls.backend import ti
 from taichi_sls.cli import main
 from taichi_sls.config import case_from_dict
 from taichi_sls.solver.scene import build_scene

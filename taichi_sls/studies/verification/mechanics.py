@@ -61,7 +61,7 @@ def run_steffen(vc: VerificationCase) -> Result:
 def perzyna_history(mat: Material, strains: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
     """Drive one point of the solver's return map (constitutive.perzyna_update) through the
     pure-shear strains eps_xy; returns (||s||, alpha) after every step."""
-    import taichi as ti
+    from taichi_sls.backend import ti
 
     from ...physics.codes import StressReading
     from ...physics.constitutive import embed3, perzyna_update
@@ -157,7 +157,7 @@ def constitutive_history(
 def _drive_kernel():
     """The point driver of :func:`constitutive_history`, built once (ndarray arguments: one
     compile, which Taichi's offline cache keeps across re-initialisations)."""
-    import taichi as ti
+    from taichi_sls.backend import ti
 
     from ...physics.constitutive import SQRT23, hencky_update, perzyna_increment
 
