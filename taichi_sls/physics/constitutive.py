@@ -109,6 +109,21 @@ def perzyna_return(mp: ti.template(), s, alpha, mu, xi, T, dt):
 
 
 @ti.func
+def perzyna_secant_at_zero(mp: ti.template(), alpha, mu, xi, T, dt):
+    """|s| / |s_trial| of :func:`perzyna_return` as the trial deviator goes to zero: 1 (elastic)
+    where the yield stress sqrt(2/3)(sigma_Y + H alpha) is positive; where it is zero every trial
+    deviator flows, and the ratio is the flow's constant 1 - 1 / (tau/dt + 1 + H/(3 mu)) (a zero-
+    yield melt at rest, whose return map reads f = 0 as elastic, is a Newtonian fluid)."""
+    sy = lerp_phase(xi, mp.yield_solid_Pa, mp.yield_liquid_Pa)
+    Hh = lerp_phase(xi, mp.hardening_solid_Pa, mp.hardening_liquid_Pa)
+    ratio = 1.0
+    if sy + Hh * alpha <= 0.0:
+        tau = viscosity(mp, T) / (2.0 * mu)
+        ratio = 1.0 - 1.0 / (tau / dt + 1.0 + Hh / (3.0 * mu))
+    return ratio
+
+
+@ti.func
 def perzyna_increment(
     mp: ti.template(), sigma, deps3, d_iso, alpha, xi, T, dt, plastic: ti.template()
 ):
@@ -343,8 +358,9 @@ def trial_stress(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L
     (the implicit step's residual; :func:`stress_update` keeps the converged one). Returns
     (sigma, mu_t, K, eta): the in-plane Cauchy stress with the solvent's, the secant shear
     modulus of the Perzyna return mu |s| / |s_trial| (mu where the step stays elastic; a zero-
-    yield melt at dt >> eta / 2 mu: ~eta / 2 dt, its Newtonian viscosity over dt), the bulk
-    modulus and the solvent viscosity, from which the implicit step builds its tangent."""
+    yield melt at dt >> eta / 2 mu: ~eta / 2 dt, its Newtonian viscosity over dt, also at rest,
+    :func:`perzyna_secant_at_zero`), the bulk modulus and the solvent viscosity, from which the
+    implicit step builds its tangent."""
     mp = mat[pt.material[p]]
     xi = pt.solid_fraction[p]
     mu, K = bulk_shear(mp, xi)
@@ -368,6 +384,11 @@ def trial_stress(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L
         tau = kirchhoff * sig3
         s_norm = (tau - tau.trace() / 3.0 * ti.Matrix.identity(float, 3)).norm()
         ratio = s_norm / (s_norm + 2.0 * mu * dgam)
+    elif ti.static(cfg.plastic):
+        # no flow at this trial: elastic, unless the yield stress is zero and the trial deviator
+        # is (a melt at rest), where the secant is the flow's limit, not mu: the implicit step
+        # keeps the tangent of its first iterate, v^n, over its Newton iterations
+        ratio = perzyna_secant_at_zero(mp, pt.equivalent_plastic_strain[p], mu, xi, pt.T[p], dt)
     sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
     for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
         sig[a, b] = sig3[a, b]

@@ -7,6 +7,8 @@ the point's block (0 outside the blocks layout)."""
 
 from taichi_sls.backend import ti
 
+from ..physics.grid import active
+from ..physics.thermal import wall_heat
 from .blocks import MARGIN, SIDE
 from .step_config import Layout
 
@@ -64,6 +66,15 @@ def add_heat_out(st: ti.template(), blk, q):
         st.blocks.heat_out[blk] = st.blocks.heat_out[blk] + q
     else:
         st.scalars.heat_out[None] += q
+
+
+@ti.func
+def wall_heat_in_order(st: ti.template(), dt_heat):
+    """The blocks layout: the fixed nodes' heat to the walls' total, summed in node order by one
+    thread (the serial layout's order), so that the total repeats bit for bit."""
+    ti.loop_config(serialize=True)
+    for I in ti.grouped(ti.ndrange(*active(st.box))):
+        st.scalars.heat_out[None] += wall_heat(st.cfg, st.nodes, I, dt_heat)
 
 
 @ti.func

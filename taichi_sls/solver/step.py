@@ -49,7 +49,6 @@ from ..physics.thermal import (
     grid_temperature,
     p2g_heat_capacity,
     p2g_heat_flux,
-    wall_heat,
 )
 from .fields import State
 from .loops import (
@@ -60,6 +59,7 @@ from .loops import (
     peak_temperature,
     point_loop,
     reduce_blocks,
+    wall_heat_in_order,
 )
 
 
@@ -233,16 +233,7 @@ def grid_update(st: ti.template(), heat: ti.template(), geom: ti.template()):
                 grid_heat(st.cfg, st.nodes, st.scalars, I, dt_heat)
     if ti.static(st.cfg.thermal and st.cfg.race_free):
         if ti.static(heat):
-            _wall_heat_in_order(st, dt_heat)
-
-
-@ti.func
-def _wall_heat_in_order(st: ti.template(), dt_heat):
-    """The blocks layout: the fixed nodes' heat to the walls' total, summed in node order by one
-    thread (the serial layout's order), so that the total repeats bit for bit."""
-    ti.loop_config(serialize=True)
-    for I in ti.grouped(ti.ndrange(*active(st.box))):
-        st.scalars.heat_out[None] += wall_heat(st.cfg, st.nodes, I, dt_heat)
+            wall_heat_in_order(st, dt_heat)
 
 
 @ti.func
