@@ -94,6 +94,7 @@ def test_maxwell_decay_rate_limits():
     assert ref.maxwell_decay_rate(lam, 1e-6) == pytest.approx(lam / (1 + lam * 1e-6))
 
 
+@pytest.mark.slow  # a convergence study (~14 s); the bar and Perzyna rows stay in default
 def test_steffen_manufactured_solution_converges():
     errs = [ver.run(ver.load("steffen", n)).errors["displacement_rms"] for n in (8, 16)]
     print("Steffen manufactured bar, RMS displacement / A at 8, 16 cells:", errs)
