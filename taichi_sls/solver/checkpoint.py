@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import CaseError
+from . import struct_copy
 from .fields import State
 
 POINT_MEMBERS = (
@@ -84,13 +85,16 @@ def capture(st: State, points: bool = True) -> dict[str, np.ndarray]:
     """The state a step changes, as host arrays (the points unless ``points`` is false, the
     scalars, the kept node fields, the blocks' ranges): what a checkpoint holds, and with the
     points kept on the device, what the adaptive step restores to redo a step it refused."""
-    members = POINT_MEMBERS if points else ()
-    data = {f"p_{k}": getattr(st.points, k).to_numpy() for k in members}
+    data = {}
+    if points:
+        data.update(
+            {f"p_{k}": v for k, v in struct_copy.to_numpy(st.points, POINT_MEMBERS).items()}
+        )
     if st.blocks is not None:
         data["b_start"] = st.blocks.start.to_numpy()
         data["b_count"] = st.blocks.count.to_numpy()
     data.update({f"s_{k}": np.array(getattr(st.scalars, k)[None]) for k in SCALARS})
-    data.update({f"g_{k}": getattr(st.nodes, k).to_numpy() for k in NODE_MEMBERS})
+    data.update({f"g_{k}": v for k, v in struct_copy.to_numpy(st.nodes, NODE_MEMBERS).items()})
     data["steps"] = np.array(st.scalars.step[None])
     return data
 
@@ -98,13 +102,12 @@ def capture(st: State, points: bool = True) -> dict[str, np.ndarray]:
 def restore(st: State, data: Mapping[str, np.ndarray]) -> None:
     """Put back a state from :func:`capture` (or a checkpoint file's arrays); the points only
     if it holds them."""
-    for k in POINT_MEMBERS if "p_x" in data else ():
-        if f"p_{k}" in data or k not in LATER_MEMBERS:
-            getattr(st.points, k).from_numpy(data[f"p_{k}"])
+    if "p_x" in data:
+        kept = [k for k in POINT_MEMBERS if f"p_{k}" in data or k not in LATER_MEMBERS]
+        struct_copy.from_numpy(st.points, {k: data[f"p_{k}"] for k in kept})
     for k in SCALARS:
         getattr(st.scalars, k)[None] = float(data[f"s_{k}"])
-    for k in NODE_MEMBERS:
-        getattr(st.nodes, k).from_numpy(data[f"g_{k}"])
+    struct_copy.from_numpy(st.nodes, {k: data[f"g_{k}"] for k in NODE_MEMBERS})
     if st.blocks is not None:
         if "b_start" in data:
             st.blocks.start.from_numpy(data["b_start"])

@@ -206,13 +206,9 @@ class State:
         struct_copy.from_numpy(self.materials, materials)
         rho = materials["density_kg_m3"][sc.material]
         pt = ti.static(self.points)
-        pt.x.from_numpy(sc.x)
-        pt.x0.from_numpy(sc.x)
-        pt.v.from_numpy(sc.v0)
-        pt.volume0.from_numpy(sc.vol)
-        pt.mass.from_numpy(sc.vol * rho)
-        pt.material.from_numpy(sc.material)
-        pt.T.from_numpy(sc.T0_C + KELVIN)
+        seeded = {"x": sc.x, "x0": sc.x, "v": sc.v0, "volume0": sc.vol, "mass": sc.vol * rho}
+        seeded.update(material=sc.material, T=sc.T0_C + KELVIN)
+        struct_copy.from_numpy(pt, seeded)
         self.surf.fit[None] = fit_matrix()
         # outside the active region the grid keeps these: empty, and outside every body
         for f in (self.nodes.phi_raw, self.nodes.phi, self.nodes.phi_smooth):
@@ -229,11 +225,10 @@ class State:
         if np.any(sc.p0 != 0.0):
             self._prestress(sc.p0)
         if sc.carried is not None:  # a previous layer's points keep their deformation and stress
+            now = struct_copy.to_numpy(pt, sc.carried_state.keys())
             for name, values in sc.carried_state.items():
-                field = getattr(self.points, name)
-                now = field.to_numpy()
-                now[sc.carried] = values[sc.carried]
-                field.from_numpy(now)
+                now[name][sc.carried] = values[sc.carried]
+            struct_copy.from_numpy(pt, now)
 
     @ti.kernel
     def _init_points(self):

@@ -20,6 +20,7 @@ import numpy as np
 from taichi_sls.backend import ti
 
 from ..physics.materials import KELVIN
+from . import struct_copy
 from .fields import State
 
 
@@ -85,7 +86,7 @@ def reduce_points(st: ti.template()):
 def point_monitors(st: State) -> tuple[dict[str, float], dict[str, float]]:
     """(monitors for the time series, internal figures for the guard)."""
     reduce_points(st)
-    r = {k: float(v) for k, v in st.totals.to_numpy().items()}
+    r = {k: float(v) for k, v in struct_copy.to_numpy(st.totals).items()}
     public = {
         "T_max_C": r["T_max"] - KELVIN,
         "T_min_C": r["T_min"] - KELVIN,

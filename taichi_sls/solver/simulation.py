@@ -13,7 +13,7 @@ from taichi_sls.backend import ti
 from .. import front_end
 from ..config import Case
 from ..physics.materials import KELVIN
-from . import checkpoint, compile_clock
+from . import checkpoint, compile_clock, struct_copy
 from .adaptive import AdaptiveStepper
 from .blocks import BlockPlan
 from .contacts import touching
@@ -288,7 +288,7 @@ class Simulation(NeckMeasures):
     def _permute(self, order: np.ndarray) -> None:
         """Every per-point array, the scene's and the host copies, in the order ``order``."""
         pt = self.state.points
-        pt.from_numpy({k: v[order] for k, v in pt.to_numpy().items()})
+        struct_copy.from_numpy(pt, {k: v[order] for k, v in struct_copy.to_numpy(pt).items()})
         self.scene = self.scene.reordered(order)
         self.state.scene = self.scene
         self._mass = self._mass[order]
@@ -400,20 +400,21 @@ class Simulation(NeckMeasures):
         then: the stress alone is 9 numbers a point): body_id, velocity_m_s (N, 2),
         displacement_vector_um (N, 2), stress_Pa (N, 3, 3; the material's Cauchy stress, not
         the melt's solvent stress, which is a force term only) and J."""
-        pt = self.state.points
-        x = pt.x.to_numpy()
-        u = x - pt.x0.to_numpy()
+        keys = ["x", "x0", "T", "equivalent_plastic_strain", "solid_fraction"]
+        pt = struct_copy.to_numpy(self.state.points, keys + (["v", "stress", "J"] if full else []))
+        x = pt["x"]
+        u = x - pt["x0"]
         snap = {
             "x_um": x * 1e6,
-            "T_C": pt.T.to_numpy() - KELVIN,
+            "T_C": pt["T"] - KELVIN,
             "displacement_um": np.linalg.norm(u, axis=1) * 1e6,
-            "plastic_strain": pt.equivalent_plastic_strain.to_numpy(),
-            "liquid_fraction": 1.0 - pt.solid_fraction.to_numpy(),
+            "plastic_strain": pt["equivalent_plastic_strain"],
+            "liquid_fraction": 1.0 - pt["solid_fraction"],
         }
         if full:  # the scene's body index follows the points when the blocks layout sorts them
             snap["body_id"] = np.asarray(self.scene.body, dtype=np.int32)
-            snap["velocity_m_s"] = pt.v.to_numpy()
+            snap["velocity_m_s"] = pt["v"]
             snap["displacement_vector_um"] = u * 1e6
-            snap["stress_Pa"] = pt.stress.to_numpy()
-            snap["J"] = pt.J.to_numpy()
+            snap["stress_Pa"] = pt["stress"]
+            snap["J"] = pt["J"]
         return snap
