@@ -250,12 +250,13 @@ def run_case(
     finally:
         bar.close()
         pt = sim.state.points
-        in_neck = neck_region(case, pt.x0.to_numpy(), sc.body, pt.mass.to_numpy())
+        arrays = sim.point_arrays()
+        in_neck = neck_region(case, arrays["x0"], sc.body, arrays["mass"])
         summary["outcome"] = outcome(
             case,
             history,
             last,
-            pt.time_molten.to_numpy(),
+            arrays["time_molten"],
             in_neck,
             solidified=solid and summary["status"] == "complete",
             baseline_um=baseline_um,

@@ -17,6 +17,7 @@ from taichi_sls.backend import ti
 
 from .codes import Strain, StressForm, StressReading
 from .materials import lerp_phase, viscosity
+from .small_matrix import conjugate, matmul
 
 SQRT23 = math.sqrt(2.0 / 3.0)
 # the smallest principal elastic stretch whose logarithm is taken: a point compressed past it
@@ -209,7 +210,7 @@ def hencky_update(
     a difference of order d(xi) dt. Then s_tr = 2 mu dev(e), the Perzyna correction of eqs.
     40-45 on the Kirchhoff deviator, tau = s + K tr(e) 1 and sigma = Q tau Q^T / J."""
     mu, K = bulk_shear(mp, xi)
-    b = f @ Fe @ Fe.transpose() @ f.transpose()
+    b = matmul(matmul(matmul(f, Fe), Fe.transpose()), f.transpose())  # f Fe Fe^T f^T, as @
     ev, Q = principal_frame(b, dim)
     e = ti.Vector.zero(float, 3)
     for i in ti.static(range(3)):
@@ -232,8 +233,7 @@ def hencky_update(
     for i in ti.static(range(3)):
         tau[i, i] = s[i, i] + K * e_vol
         lam[i, i] = ti.exp(s[i, i] / (2.0 * mu) + e_vol / 3.0)
-    Qt = Q.transpose()
-    return Q @ tau @ Qt / J, Q @ lam @ Qt, dgam, Q @ n @ Qt
+    return conjugate(Q, tau) / J, conjugate(Q, lam), dgam, conjugate(Q, n)
 
 
 @ti.func

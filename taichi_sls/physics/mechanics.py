@@ -30,7 +30,7 @@ from taichi_sls.backend import ti
 
 from .codes import Transfer, WallMechanical
 from .grid import node_x, scatter_add
-from .shape import STENCIL, node_weight
+from .shape import STENCIL_SHAPE, node_weight
 
 
 @ti.func
@@ -59,7 +59,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         if ti.static(cfg.solvent):
             sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
     g = ti.Vector(cfg.gravity, dt=float)
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         I = base + o
         mv = vp
@@ -116,7 +116,7 @@ def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
     v_pic = ti.Vector.zero(float, cfg.dim)
     dv = ti.Vector.zero(float, cfg.dim)
     B = ti.Matrix.zero(float, cfg.dim, cfg.dim)
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         I = base + o
         vi = nd.v[I]
@@ -148,7 +148,7 @@ def interpolate_velocity(cfg: ti.template(), nd: ti.template(), base, w, dw):
     """The grid velocity at a point and its gradient L = sum_i v_i grad N_i (eq. 16)."""
     v_grid = ti.Vector.zero(float, cfg.dim)
     L = ti.Matrix.zero(float, cfg.dim, cfg.dim)
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         vi = nd.v[base + o]
         v_grid += N * vi
@@ -175,7 +175,7 @@ def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
     """MUSL: the updated point momenta back to the grid (affine part included for APIC)."""
     xp = pt.x[p]
     mp = inertia(cfg, pt.mass[p])
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         I = base + o
         mv = pt.v[p]

@@ -10,8 +10,10 @@ from taichi_sls.backend import ti
 # Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
 # surface tension and output are 2D (plane strain) for now.
 DIM = 2
-# The 3^DIM node offsets of the stencil, for `for o in ti.static(ti.grouped(STENCIL))`.
-STENCIL = ti.ndrange(*((3,) * DIM))
+# The 3^DIM node offsets of the stencil. Loops over them run at run time,
+# `for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE))`: a `ti.static` loop would make the front end
+# build its body 3^DIM times at every call site (docs/compile.md).
+STENCIL_SHAPE = (3,) * DIM
 
 
 @ti.func
@@ -49,7 +51,7 @@ def stencil(xp, inv_h, h, lp, origin_idx):
     for d in ti.static(range(dim)):
         f = xp[d] * inv_h
         base[d] = ti.cast(ti.floor(f + 0.5), ti.i32) - 1
-        for a in ti.static(range(3)):
+        for a in range(3):  # at run time: one copy of gimp_1d, not 3 dim (the front end's cost)
             xi = (f - ti.cast(base[d] + a, float)) * h
             s, ds = gimp_1d(xi, h, lp)
             w[a, d] = s

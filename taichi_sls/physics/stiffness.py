@@ -25,7 +25,7 @@ gathers it into a sparse matrix.
 
 from taichi_sls.backend import ti
 
-from .shape import STENCIL, node_weight, stencil
+from .shape import node_weight, stencil
 from .surface_energy import GAUSS, outline_segments
 
 REACH = 2  # nodes of one row lie within REACH of the diagonal node along every axis
@@ -34,13 +34,13 @@ WIDTH = 2 * REACH + 1
 
 @ti.func
 def stencil_gradients(w, dw):
-    """grad N of the 3^dim stencil nodes, one row per node in STENCIL order (static offsets):
-    the pair loops below run over them at run time, so that they compile as one loop body
-    instead of 81 unrolled ones."""
+    """grad N of the 3^dim stencil nodes, one row per node in stencil order (the last axis
+    fastest): the pair loops below run over them at run time, so that they compile as one loop
+    body instead of 81 unrolled ones."""
     dim = ti.static(w.m)
     G = ti.Matrix.zero(float, 3**dim, dim)
-    for k, o in ti.static(enumerate(ti.grouped(STENCIL))):
-        N, g = node_weight(w, dw, o)
+    for k in range(3**dim):
+        N, g = node_weight(w, dw, stencil_offset(k, dim))
         for d in ti.static(range(dim)):
             G[k, d] = g[d]
     return G
@@ -48,7 +48,7 @@ def stencil_gradients(w, dw):
 
 @ti.func
 def stencil_offset(k, dim: ti.template(), side: ti.template() = 3):
-    """The offset of node k of a block of side^dim nodes, the last axis fastest (STENCIL's
+    """The offset of node k of a block of side^dim nodes, the last axis fastest (the stencil's
     order for side 3; a matrix row's nodes for side WIDTH)."""
     o = ti.Vector.zero(ti.i32, dim)
     r = k

@@ -38,7 +38,7 @@ from taichi_sls.backend import ti
 
 from .contour import cell_segments
 from .grid import active, ramped_gamma, scatter_add
-from .shape import STENCIL, node_weight, stencil
+from .shape import STENCIL_SHAPE, node_weight, stencil
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
 
@@ -57,7 +57,7 @@ GAUSS = {
 def scatter_volume(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
     """Volume colour: V_p N_i(x_p) onto the 3x3 nodes of point p (in the P2G loop)."""
     Vp = pt.volume0[p] * pt.J[p]
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         scatter_add(cfg, nd.volume, base + o, N * Vp)
 
@@ -100,7 +100,7 @@ def segment_force(cfg: ti.template(), nd: ti.template(), a, b, gamma):
         for q in ti.static(range(len(s))):
             xq = a + s[q] * d
             base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
-            for o in ti.static(ti.grouped(STENCIL)):
+            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
                 N, gN = node_weight(w, dw, o)
                 I = base + o
                 tg = t.dot(gN)

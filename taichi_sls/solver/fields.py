@@ -151,6 +151,7 @@ class ImplicitFields:
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.free = ti.Vector.field(cfg.dim, ti.i32, grid)
         self.dof = ti.Vector.field(cfg.dim, ti.i32, grid)
+        self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
         if cfg.heat_implicit:  # backward-Euler heat (solver/implicit_heat.py)
             self.conductance = ti.field(float, grid + (WIDTH,) * cfg.dim)
             self.heat_node = ti.field(ti.i32, grid)  # physics.codes.HeatNode
@@ -211,8 +212,8 @@ class State:
         struct_copy.from_numpy(pt, seeded)
         self.surf.fit[None] = fit_matrix()
         # outside the active region the grid keeps these: empty, and outside every body
-        for f in (self.nodes.phi_raw, self.nodes.phi, self.nodes.phi_smooth):
-            f.fill(cfg.phi_cap)
+        cap = np.full((cfg.nx, cfg.ny), cfg.phi_cap)
+        struct_copy.from_numpy(self.nodes, {"phi_raw": cap, "phi": cap, "phi_smooth": cap})
         full = [0, 0, cfg.nx, cfg.ny]
         self.box[None] = [cfg.nx, cfg.ny, 0, 0] if cfg.active_region else full
         if cfg.n_lasers:

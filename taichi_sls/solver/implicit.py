@@ -41,7 +41,7 @@ from ..physics.codes import SurfaceMethod
 from ..physics.constitutive import trial_stress
 from ..physics.grid import active, ramped_gamma
 from ..physics.mechanics import apply_walls, interpolate_velocity
-from ..physics.shape import STENCIL, node_weight
+from ..physics.shape import STENCIL_SHAPE, node_weight
 from ..physics.stiffness import (
     WIDTH,
     capillary_tangent,
@@ -142,7 +142,7 @@ def _point_force(st: ti.template(), p):
     v_grid, L = interpolate_velocity(st.cfg, st.nodes, base, w, dw)
     sig, mu_t, K, eta = trial_stress(st.cfg, pt, st.materials, p, L, dt)
     V = pt.volume0[p] * pt.J[p]
-    for o in ti.static(ti.grouped(STENCIL)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         st.implicit.internal[base + o] += -V * (sig @ gN)
     a_lam = dt * (K - 2.0 * mu_t / 3.0) - 2.0 * eta / 3.0
@@ -152,48 +152,35 @@ def _point_force(st: ti.template(), p):
 
 @ti.func
 def _force_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    _point_force(st, p)
-
-
-@ti.func
-def _force_and_tangent_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     base, w, dw, V, a_lam, a_mu = _point_force(st, p)
-    scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
+    if st.implicit.with_tangent[None]:
+        scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
 
 
 @ti.kernel
-def internal_force(
-    st: ti.template(),
-    v: ti.types.ndarray(),
-    dof_node: ti.types.ndarray(),
-    tangent: ti.template(),
-):
-    """The grid velocity from the unknowns v, then f^int(v) and (``tangent``) the points'
-    tangent."""
+def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.ndarray()):
+    """The grid velocity from the unknowns v, then f^int(v) and (``implicit.with_tangent``)
+    the points' tangent. A flag read at run time, not a template argument: one kernel whose
+    front end builds the stress update once, instead of two."""
     if ti.static(st.cfg.parallel):
-        _internal_force(st, v, dof_node, tangent)
+        _internal_force(st, v, dof_node)
     else:
         ti.loop_config(serialize=True)
         for _ in range(1):
-            _internal_force(st, v, dof_node, tangent)
+            _internal_force(st, v, dof_node)
 
 
 @ti.func
-def _internal_force(
-    st: ti.template(), v: ti.template(), dof_node: ti.template(), tangent: ti.template()
-):
+def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(tangent):
+        if st.implicit.with_tangent[None]:
             _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
         st.implicit.internal[I] = ti.Vector.zero(float, st.cfg.dim)
         nd.v[I] = ti.Vector.zero(float, st.cfg.dim)
     for k in range(v.shape[0]):
         nd.v[dof_index(st, dof_node, k)][dof_node[k, st.cfg.dim]] = v[k]
-    if ti.static(tangent):
-        point_loop(st, _force_and_tangent_body, False, False, True)
-    else:
-        point_loop(st, _force_body, False, False, True)
+    point_loop(st, _force_body, False, False, True)
 
 
 @ti.func
@@ -295,7 +282,8 @@ class ImplicitStepper:
         """f^int(v) at the unknowns and (``tangent``) the points' tangent on the stored
         entries."""
         st = self.st
-        internal_force(st, v, sys_.dof_node, tangent)
+        st.implicit.with_tangent[None] = int(tangent)
+        internal_force(st, v, sys_.dof_node)
         f_int = np.empty(sys_.n)
         if not tangent:
             gather_force(st, sys_.dof_node, f_int)

@@ -9,19 +9,19 @@ from .monitor import neck_measures
 
 
 class NeckMeasures:
-    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass`` and
-    ``_body_radius`` (set by :class:`Simulation`)."""
+    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass``,
+    ``_body_radius``, ``point_arrays`` and ``node_arrays`` (of :class:`Simulation`)."""
 
     def phi(self) -> np.ndarray:
         """Level set of eq. 21 on the nodes (m) of the current points."""
         level_set_only(self.state)
-        return self.state.nodes.phi.to_numpy()
+        return self.node_arrays()["phi"]
 
     def colour(self) -> np.ndarray:
         """The surface-energy colour c_i of the current points on the nodes (the contoured
         one: filtered when the case filters it)."""
         colour_only(self.state)
-        return self.state.nodes.colour.to_numpy()
+        return self.node_arrays()["colour"]
 
     def neck_measure(self) -> str:
         """The interface the contact line is read on: the force's own (``output.neck_measure =
@@ -53,10 +53,10 @@ class NeckMeasures:
         """The colour c_i of the current points before any filter: the cell fraction that
         material fills, from the node mass (or volume, as the case's force takes it)."""
         self.colour()  # the grid's mass and volume of the current points
-        cfg, nd = self.state.cfg, self.state.nodes
+        cfg, nd = self.state.cfg, self.node_arrays()
         if cfg.se.volume_colour:
-            return nd.volume.to_numpy() / cfg.cell_volume
-        return nd.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
+            return nd["volume"] / cfg.cell_volume
+        return nd["mass"] / (cfg.rho_ref * cfg.cell_volume)
 
     def _material_field(self, measure: str, section: str) -> np.ndarray:
         """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
@@ -91,8 +91,7 @@ class NeckMeasures:
     def body_centres_m(self, initial: bool = False) -> np.ndarray:
         """Each body's mass centre (m), (bodies, 2): of the current points, or (``initial``) of
         their start positions."""
-        pt = self.state.points
-        x = (pt.x0 if initial else pt.x).to_numpy()
+        x = self.point_arrays()["x0" if initial else "x"]
         body, m = self.scene.body, self._mass
         n_b = len(self._body_radius)
         return (
@@ -110,10 +109,10 @@ class NeckMeasures:
         it; equal to :meth:`necks_m` on the colour for a case of two bodies."""
         if not self.contacts:
             return []
-        pt, cfg = self.state.points, self.state.cfg
-        x = pt.x.to_numpy()
+        pt, cfg = self.point_arrays(), self.state.cfg
+        x = pt["x"]
         if cfg.se.volume_colour:
-            weight = pt.volume0.to_numpy() * pt.J.to_numpy() / cfg.cell_volume
+            weight = pt["volume0"] * pt["J"] / cfg.cell_volume
         else:
             weight = self._mass / (cfg.rho_ref * cfg.cell_volume)
         body = self.scene.body

@@ -38,6 +38,10 @@ from .time_step import (
 )
 
 OFFLINE_CACHE_BYTES = 2**30  # ~5 MB a case's kernels
+# what the host reads of the points and of the nodes, each copied by one kernel (a member's
+# own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
+HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
+HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
 
 
 def init_taichi(
@@ -147,7 +151,7 @@ class Simulation(NeckMeasures):
         # every kernel compiled in the constructor (the field layout's included); later ones
         # (settle, hand-over) count in run_case's summary through the same clock
         self.compile_s = compile_clock.since(clock0)["compile_s"]
-        self._mass = self.state.points.mass.to_numpy()
+        self._mass = self.point_arrays()["mass"]
         # each point's index in the order the run started with: the blocks layout sorts the
         # points again as they flow, and a checkpoint keeps that order
         self.point_order = np.arange(self.scene.n_points)
@@ -280,7 +284,7 @@ class Simulation(NeckMeasures):
     def sort_points(self) -> None:
         """Blocks layout: the points sorted by block again (every per-point array and the
         scene's), and the blocks' ranges."""
-        x = self.state.points.x.to_numpy()
+        x = self.point_arrays()["x"]
         order = self.blocks.order(x)
         self._permute(order)
         self.blocks.set_ranges(x[order])
@@ -344,7 +348,7 @@ class Simulation(NeckMeasures):
             gamma = max(m.surface_tension_N_m for m in c.materials.values())
             g = math.hypot(*c.physics.gravity_m_s2)
             M = float(self._mass.sum())
-            v0 = self.state.points.v.to_numpy()
+            v0 = self.point_arrays()["v"]
             ke0 = 0.5 * float((self._mass * (v0**2).sum(axis=1)).sum())
             self._e_static = ke0 + gamma * c.perimeter_um() * 1e-6 + M * g * self.scene.height
         return self._e_static + float(self.state.scalars.laser_energy[None])
@@ -394,14 +398,22 @@ class Simulation(NeckMeasures):
             h.restart_stretch(self.t)
         return extra
 
+    def point_arrays(self) -> dict[str, np.ndarray]:
+        """The points' members the host reads (HOST_POINT_MEMBERS), copied by one kernel."""
+        return struct_copy.to_numpy(self.state.points, HOST_POINT_MEMBERS)
+
+    def node_arrays(self) -> dict[str, np.ndarray]:
+        """The node fields the neck measures read (HOST_NODE_MEMBERS), copied by one kernel."""
+        return struct_copy.to_numpy(self.state.nodes, HOST_NODE_MEMBERS)
+
     def snapshot(self, full: bool = False) -> dict[str, np.ndarray]:
         """The points for output: position (um), T_C, displacement magnitude (um), equivalent
         plastic strain, liquid fraction; ``full`` adds what the VTU holds besides (read only
         then: the stress alone is 9 numbers a point): body_id, velocity_m_s (N, 2),
         displacement_vector_um (N, 2), stress_Pa (N, 3, 3; the material's Cauchy stress, not
         the melt's solvent stress, which is a force term only) and J."""
-        keys = ["x", "x0", "T", "equivalent_plastic_strain", "solid_fraction"]
-        pt = struct_copy.to_numpy(self.state.points, keys + (["v", "stress", "J"] if full else []))
+        # the checkpoint's members: one copy kernel for both (each compiles once per process)
+        pt = struct_copy.to_numpy(self.state.points, checkpoint.POINT_MEMBERS)
         x = pt["x"]
         u = x - pt["x0"]
         snap = {

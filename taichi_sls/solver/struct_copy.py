@@ -34,13 +34,15 @@ def _element(shape: ti.template(), i):
 @ti.kernel
 def _from_table(sf: ti.template(), layout: ti.template(), table: ti.types.ndarray()):
     for i in range(table.shape[0]):
-        for k in ti.static(range(len(layout))):
-            name, col, comp = ti.static(layout[k])
-            f = ti.static(sf.field_dict[name])
-            if ti.static(len(f.shape) == 0):
-                _put(f, None, comp, col, table, i)
-            else:
-                _put(f, _element(f.shape, i), comp, col, table, i)
+        if ti.static(len(sf.shape) == 0):
+            for k in ti.static(range(len(layout))):
+                name, col, comp = ti.static(layout[k])
+                _put(sf.field_dict[name], None, comp, col, table, i)
+        else:
+            at = _element(sf.shape, i)
+            for k in ti.static(range(len(layout))):
+                name, col, comp = ti.static(layout[k])
+                _put(sf.field_dict[name], at, comp, col, table, i)
 
 
 @ti.func
@@ -65,13 +67,15 @@ def _put(
 @ti.kernel
 def _to_table(sf: ti.template(), layout: ti.template(), table: ti.types.ndarray()):
     for i in range(table.shape[0]):
-        for k in ti.static(range(len(layout))):
-            name, col, comp = ti.static(layout[k])
-            f = ti.static(sf.field_dict[name])
-            if ti.static(len(f.shape) == 0):
-                _get(f, None, comp, col, table, i)
-            else:
-                _get(f, _element(f.shape, i), comp, col, table, i)
+        if ti.static(len(sf.shape) == 0):
+            for k in ti.static(range(len(layout))):
+                name, col, comp = ti.static(layout[k])
+                _get(sf.field_dict[name], None, comp, col, table, i)
+        else:
+            at = _element(sf.shape, i)
+            for k in ti.static(range(len(layout))):
+                name, col, comp = ti.static(layout[k])
+                _get(sf.field_dict[name], at, comp, col, table, i)
 
 
 @ti.func

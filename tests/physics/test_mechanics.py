@@ -10,7 +10,7 @@ from taichi_sls.backend import ti
 from taichi_sls.config import Material
 from taichi_sls.physics.codes import StressReading
 from taichi_sls.physics.constitutive import embed3, perzyna_update
-from taichi_sls.physics.shape import STENCIL, node_weight, stencil
+from taichi_sls.physics.shape import STENCIL_SHAPE, node_weight, stencil
 from taichi_sls.solver.params import p_wave_modulus, stability_limits
 from taichi_sls.solver.simulation import Simulation, init_taichi
 from taichi_sls.studies import verification as ver
@@ -29,7 +29,7 @@ def test_gimp_partition_of_unity_and_gradient_sum():
         for p in range(n):
             base, w, dw = stencil(xs[p], 1.0 / h, h, 0.25 * h, 4)
             s = ti.Vector.zero(float, 3)
-            for o in ti.static(ti.grouped(STENCIL)):
+            for o in ti.static(ti.grouped(ti.ndrange(*STENCIL_SHAPE))):
                 N, g = node_weight(w, dw, o)
                 s += ti.Vector([N, g[0], g[1]])
             out[p] = s
