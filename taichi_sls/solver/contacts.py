@@ -112,9 +112,8 @@ def neck_width(
     edges) is sampled every SECTION_STEP cells out to ``reach`` on either side, and the width is
     the distance between the outermost crossings of the interface (so that the empty strip of
     points along a symmetry line, a hole inside the neck, does not shorten it). The neck is the
-    narrowest section between the widest on either side of the middle (the narrowest of all
-    while the neck is concave; the middle once the pair has turned convex); 0 where a section
-    holds no material (a torn neck).
+    narrowest section, or the widest once the pair has turned convex (no waist: the narrowest
+    would be the range's end); 0 where a section holds no material (a torn neck).
     """
     d = float(np.linalg.norm(cb - ca))
     # a blown-up state (the guard reports it): centres NaN, or flung far beyond the bodies' size
@@ -128,13 +127,14 @@ def neck_width(
     xy = ca[None, None, :] + s[:, None, None] * e + t[None, :, None] * n  # (S, T, 2)
     c = bilinear(material, h, off, xy[..., 0], xy[..., 1], outside=-1.0)
     widths = np.array([_outer_span(row, t) for row in c])
-    # the waist lies between the widest section on either side of the middle: once a
-    # coalescing pair turns convex its sections narrow away from the middle, and the
-    # narrowest of all would be the range's end, not the neck (Hopper's r_n is the middle)
+    k = int(np.argmin(widths))
+    # a pair coalesced past its waist is convex: its sections narrow away from the middle, and
+    # the narrowest is the range's end, not the neck; read it where it is widest (Hopper's r_n
+    # is the middle section). A pair with a waist (every cold or part-fused contact) keeps
+    # the narrowest section.
     mid = len(s) // 2
-    lo = int(np.argmax(widths[: mid + 1]))
-    hi = mid + int(np.argmax(widths[mid:]))
-    k = lo + int(np.argmin(widths[lo : hi + 1]))
+    if k in (0, len(s) - 1) and widths[mid] > max(widths[0], widths[-1]):
+        k = int(np.argmax(widths))
     return float(widths[k]), ca + s[k] * e
 
 

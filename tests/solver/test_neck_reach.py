@@ -43,8 +43,8 @@ def _read(tau: float, turn_deg: float) -> float:
 def test_neck_follows_hopper(tau: float) -> None:
     # 3 % (the bar): at tau = 0.5 the neck's radius of curvature is about a cell and the
     # bilinear field cuts it (-2.4 % measured); from tau = 1 on the reading is within 0.3 %.
-    # Before pair_reach the width stopped at 2 R0 (1.000 at tau 2 and 3), and before the waist
-    # rule the convex pair at tau 3 read a section at the range's end (-2 %).
+    # Before pair_reach the width stopped at 2 R0 (1.000 at tau 2 and 3), and before the convex
+    # rule the pair at tau 3 read a section at the range's end (-2 %).
     assert _read(tau, 0.0) == pytest.approx(float(hopper_neck_at(tau)), rel=0.03)
 
 
