@@ -112,7 +112,8 @@ def neck_width(
     edges) is sampled every SECTION_STEP cells out to ``reach`` on either side, and the width is
     the distance between the outermost crossings of the interface (so that the empty strip of
     points along a symmetry line, a hole inside the neck, does not shorten it). The neck is the
-    narrowest section; 0 where a section holds no material (a torn neck).
+    narrowest section, or the widest once the pair has turned convex (no waist: the narrowest
+    would be the range's end); 0 where a section holds no material (a torn neck).
     """
     d = float(np.linalg.norm(cb - ca))
     # a blown-up state (the guard reports it): centres NaN, or flung far beyond the bodies' size
@@ -127,7 +128,24 @@ def neck_width(
     c = bilinear(material, h, off, xy[..., 0], xy[..., 1], outside=-1.0)
     widths = np.array([_outer_span(row, t) for row in c])
     k = int(np.argmin(widths))
+    # a pair coalesced past its waist is convex: its sections narrow away from the middle, and
+    # the narrowest is the range's end, not the neck; read it where it is widest (Hopper's r_n
+    # is the middle section). A pair with a waist (every cold or part-fused contact) keeps
+    # the narrowest section.
+    mid = len(s) // 2
+    if k in (0, len(s) - 1) and widths[mid] > max(widths[0], widths[-1]):
+        k = int(np.argmax(widths))
     return float(widths[k]), ca + s[k] * e
+
+
+def pair_reach(ra: float, rb: float) -> float:
+    """How far either side of the line of centres a section of one pair is sampled (m).
+
+    sqrt(ra^2 + rb^2), the radius of the disc holding both bodies' area: the end state of a
+    coalescence, so the section of a pair fused to the end still lies within it (the smaller
+    radius, the earlier reach, capped the width at the initial diameter).
+    """
+    return math.sqrt(ra * ra + rb * rb)
 
 
 def _outer_span(c: np.ndarray, t: np.ndarray) -> float:

@@ -3,7 +3,7 @@ set and colour on the nodes, the contact line of the paper's pair, the neck of e
 
 import numpy as np
 
-from .contacts import neck_width, point_colour
+from .contacts import neck_width, pair_reach, point_colour
 from .grid_views import colour_only, level_set_only
 from .monitor import neck_measures
 
@@ -125,6 +125,7 @@ class NeckMeasures:
         for a, b in self.contacts:
             sel = np.concatenate([members[a], members[b]])
             c = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
-            reach = min(self._body_radius[a], self._body_radius[b])
+            # the pair's own colour holds no neighbours: reach out to the coalesced end state
+            reach = pair_reach(self._body_radius[a], self._body_radius[b])
             out.append(neck_width(c, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
         return out
