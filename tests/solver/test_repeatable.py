@@ -34,7 +34,6 @@ CASE = {
     "output": {"frames": 4, "png": False, "gif": False},
 }
 # what measures the machine, not the run
-# how long things took, and how much was compiled (a warm cache compiles less), not what was computed
 TIMINGS = (
     "compile_s",
     "compile_front_end_s",
