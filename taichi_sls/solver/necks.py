@@ -3,14 +3,28 @@ set and colour on the nodes, the contact line of the paper's pair, the neck of e
 
 import numpy as np
 
+from . import struct_copy
 from .contacts import neck_width, pair_reach, point_colour
 from .grid_views import colour_only, level_set_only
 from .monitor import neck_measures
 
+# what the host reads of the points and of the nodes, each copied by one kernel (a member's
+# own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
+HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
+HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
+
 
 class NeckMeasures:
-    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass``,
-    ``_body_radius``, ``point_arrays`` and ``node_arrays`` (of :class:`Simulation`)."""
+    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass`` and
+    ``_body_radius`` (set by :class:`Simulation`)."""
+
+    def point_arrays(self) -> dict[str, np.ndarray]:
+        """The points' members the host reads (HOST_POINT_MEMBERS), copied by one kernel."""
+        return struct_copy.to_numpy(self.state.points, HOST_POINT_MEMBERS)
+
+    def node_arrays(self) -> dict[str, np.ndarray]:
+        """The node fields the neck measures read (HOST_NODE_MEMBERS), copied by one kernel."""
+        return struct_copy.to_numpy(self.state.nodes, HOST_NODE_MEMBERS)
 
     def phi(self) -> np.ndarray:
         """Level set of eq. 21 on the nodes (m) of the current points."""

@@ -38,10 +38,6 @@ from .time_step import (
 )
 
 OFFLINE_CACHE_BYTES = 2**30  # ~5 MB a case's kernels
-# what the host reads of the points and of the nodes, each copied by one kernel (a member's
-# own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
-HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
-HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
 
 
 def init_taichi(
@@ -397,14 +393,6 @@ class Simulation(NeckMeasures):
             self.state.scalars.dt[None] = self.dt
             h.restart_stretch(self.t)
         return extra
-
-    def point_arrays(self) -> dict[str, np.ndarray]:
-        """The points' members the host reads (HOST_POINT_MEMBERS), copied by one kernel."""
-        return struct_copy.to_numpy(self.state.points, HOST_POINT_MEMBERS)
-
-    def node_arrays(self) -> dict[str, np.ndarray]:
-        """The node fields the neck measures read (HOST_NODE_MEMBERS), copied by one kernel."""
-        return struct_copy.to_numpy(self.state.nodes, HOST_NODE_MEMBERS)
 
     def snapshot(self, full: bool = False) -> dict[str, np.ndarray]:
         """The points for output: position (um), T_C, displacement magnitude (um), equivalent
