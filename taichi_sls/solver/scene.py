@@ -159,6 +159,11 @@ def laplace_pressure(case: Case, body) -> float:
 
 def build_scene(case: Case) -> Scene:
     """Seed the points of every body (a point belongs to the first body that holds it)."""
+    if case.domain.dim != 2:
+        raise CaseError(
+            f"domain.dim = {case.domain.dim}: the 3D grid and seeding are not built yet "
+            "(issue #39); allowed: 2"
+        )
     h_um = case.grid.spacing_um
     W, H = case.domain.width_um, case.domain.height_um
     ncx = int(round(W / h_um))

@@ -171,7 +171,7 @@ def step_config(
     floor = st.surface_energy_mass_floor * rho_ref * h**2
     implicit = case.implicit_mechanics()
     return StepConfig(
-        dim=2,
+        dim=case.domain.dim,
         n_points=scene.n_points,
         nx=scene.nx,
         ny=scene.ny,
