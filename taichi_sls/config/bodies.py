@@ -46,6 +46,10 @@ class Disc(BodyBase):
     def perimeter_um(self) -> float:
         return 2 * math.pi * self.radius_um
 
+    def area_um2(self) -> float:
+        """The surface of the sphere that a disc with a 3D centre is."""
+        return 4 * math.pi * self.radius_um**2
+
 
 class Rect(BodyBase):
     shape: Literal["rect"] = Field(description="disc, rect, polygon or points")
@@ -61,6 +65,11 @@ class Rect(BodyBase):
 
     def perimeter_um(self) -> float:
         return 2 * (self.max_um[0] - self.min_um[0] + self.max_um[1] - self.min_um[1])
+
+    def area_um2(self) -> float:
+        """The surface of the box that a rect with 3D corners is."""
+        a, b, c = (hi - lo for lo, hi in zip(self.min_um, self.max_um, strict=True))
+        return 2 * (a * b + b * c + c * a)
 
 
 class Polygon(BodyBase):

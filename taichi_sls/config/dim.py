@@ -7,6 +7,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from .errors import CaseError
+from .sections import Wall
 
 if TYPE_CHECKING:
     from .schema import Case
@@ -17,12 +18,13 @@ def check_dimension(case: Case) -> None:
     dim = case.domain.dim
     _check_coordinates(case, dim)
     if dim == 2:
-        given = case.boundary.model_fields_set & {"front", "back"}
-        if given:
-            raise CaseError(
-                f"boundary.{sorted(given)[0]}: a wall in z, 3D only (domain.dim = 2; allowed: "
-                "left, right, bottom, top)"
-            )
+        # a wall in z set away from its default (a dumped 2D case carries the defaults)
+        for key in ("front", "back"):
+            if getattr(case.boundary, key) != Wall():
+                raise CaseError(
+                    f"boundary.{key}: a wall in z, 3D only (domain.dim = 2; allowed: left, "
+                    "right, bottom, top)"
+                )
         if case.domain.depth_um is not None:
             raise CaseError(
                 f"domain.depth_um = {case.domain.depth_um}: 3D only (domain.dim = 2 is a plane "
@@ -79,6 +81,16 @@ def _refuse_in_3d(case: Case) -> None:
                 f'bodies[{i}].shape = "points" with domain.dim = 3: layer files are {not_yet}; '
                 'allowed in 3D: "disc" (a sphere), "rect" (a box)'
             )
+        if b.shape == "disc" and b.perturbation != 0.0:
+            raise CaseError(
+                f"bodies[{i}].perturbation = {b.perturbation} with domain.dim = 3: a shape mode "
+                f"of a sphere is {not_yet}; allowed in 3D: 0"
+            )
+    if case.grid.seeding == "area":
+        raise CaseError(
+            f'grid.seeding = "area" with domain.dim = 3: area seeding is {not_yet}; allowed in '
+            '3D: "centre"'
+        )
     if case.bed is not None:
         raise CaseError(
             f"bed with domain.dim = 3: a generated bed is {not_yet}; allowed in 3D: [[bodies]]"

@@ -326,6 +326,13 @@ class Case(Model):
         """Total outline length of the bodies as seeded (um)."""
         return sum(b.perimeter_um() for b in self.bodies)
 
+    def outline_um(self) -> float:
+        """The bodies' outline as seeded: their perimeter (um, per unit depth) in 2D, their
+        surface (um^2) in 3D, whose bodies are spheres and boxes."""
+        if self.domain.dim == 2:
+            return self.perimeter_um()
+        return sum(b.area_um2() for b in self.bodies)
+
     def top_um(self) -> float:
         """The highest point of any body (um): the top of the powder."""
         return max(b.extent()[1][1] for b in self.bodies)

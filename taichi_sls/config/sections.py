@@ -48,7 +48,8 @@ class Domain(Model):
         2,
         description="2: a plane section, every extensive output per unit depth (energies in "
         "J/m, the _J_per_m columns); 3: a box width x height x depth, the same outputs in J "
-        "(the column names keep _J_per_m); y is up in both. 3D is being built (issue #39): "
+        "(the column names keep _J_per_m); y is up in both. 3D (issue #39) runs the explicit "
+        "mechanics and heat of spheres ([[bodies]] discs with [x, y, z] centres) and boxes; "
         "what it lacks is refused by its key (docs/limitations.md)",
     )
     width_um: float = Field(80.0, gt=0, description="domain width (um); x from 0")
@@ -198,7 +199,8 @@ class Thermal(Model):
         1.0,
         ge=0,
         description="rate of the sub-grid temperature filter, in units of 1 / the thermal "
-        "stability limit h^2 rho c / 4k: each heat step removes 1 - exp(-rate dt_heat / limit) "
+        "stability limit h^2 rho c / 4k (2D; 6k in 3D): each heat step removes "
+        "1 - exp(-rate dt_heat / limit) "
         "of the points' sub-grid temperature noise (energy-conserving; physics/thermal.py). "
         "Increments alone never damp it, and stirred by the flow it grew to 6 K below the plate "
         "over 30 ms; rates of 3 and more overshoot at a sharp front; 0: increments alone (FLIP)",

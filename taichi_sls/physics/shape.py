@@ -7,11 +7,9 @@ closer than h + l_p. With node spacing h that is at most three nodes per axis, s
 
 from taichi_sls.backend import ti
 
-# Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
-# surface tension and output are 2D (plane strain) for now.
-DIM = 2
-# The 3^DIM node offsets of the stencil, for `for o in ti.static(ti.grouped(STENCIL))`.
-STENCIL = ti.ndrange(*((3,) * DIM))
+# The 3^dim node offsets of a point's stencil by dimension, for
+# `for o in ti.static(ti.grouped(STENCIL[cfg.dim]))` (unrolled at compile time).
+STENCIL = {dim: ti.ndrange(*((3,) * dim)) for dim in (2, 3)}
 
 
 @ti.func

@@ -39,7 +39,7 @@ def stencil_gradients(w, dw):
     instead of 81 unrolled ones."""
     dim = ti.static(w.m)
     G = ti.Matrix.zero(float, 3**dim, dim)
-    for k, o in ti.static(enumerate(ti.grouped(STENCIL))):
+    for k, o in ti.static(enumerate(ti.grouped(STENCIL[dim]))):
         N, g = node_weight(w, dw, o)
         for d in ti.static(range(dim)):
             G[k, d] = g[d]

@@ -94,6 +94,8 @@ REFUSED_IN_3D = [
     ({"lasers": [{"power_W": 25.0}]}, "lasers[0].power_W = 25.0"),
     ({"output": {"png": True}}, "output.png = true"),
     ({"output": {"vtu": True}}, "output.vtu = true"),
+    ({"grid": {"seeding": "area"}}, 'grid.seeding = "area"'),
+    ({"bodies": [{"center_um": [20.0, 20.0, 16.0], "perturbation": 0.1}]}, "perturbation = 0.1"),
 ]
 
 
@@ -101,13 +103,6 @@ REFUSED_IN_3D = [
 def test_what_3d_lacks_is_refused_by_its_key(extra, says):
     msg = _error(deep_update(SPHERE, extra))
     assert says in msg and "domain.dim = 3" in msg and "allowed" in msg
-    # and the same keys stay allowed in 2D (the polygon and the bed need their own scenes)
-    if "polygon" not in says and "bed" not in says:
+    # and the same keys stay allowed in 2D (the bodies and the bed need their own scenes)
+    if "bodies" not in extra:
         case_from_dict(deep_update(PAPER_SCENE, extra))
-
-
-def test_3d_is_refused_by_the_solver_until_its_grid_is_built():
-    from taichi_sls.solver.scene import build_scene
-
-    with pytest.raises(CaseError, match=r"^domain\.dim = 3: the 3D grid"):
-        build_scene(case_from_dict(SPHERE))
