@@ -4,16 +4,13 @@ paper's level-set CSF, ever), each naming its key, its value and what is allowed
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Any
 
 from .errors import CaseError
 from .sections import Wall
 
-if TYPE_CHECKING:
-    from .schema import Case
 
-
-def check_dimension(case: Case) -> None:
+def check_dimension(case: Any) -> None:
     """Refuse what ``case.domain.dim`` cannot run; called before any other cross-check."""
     dim = case.domain.dim
     _check_coordinates(case, dim)
@@ -34,7 +31,7 @@ def check_dimension(case: Case) -> None:
     _refuse_in_3d(case)
 
 
-def _check_coordinates(case: Case, dim: int) -> None:
+def _check_coordinates(case: Any, dim: int) -> None:
     """Positions have ``dim`` components; a velocity or gravity may leave z out in 3D (0)."""
     for i, b in enumerate(case.bodies):
         for key in ("center_um", "min_um", "max_um"):
@@ -56,7 +53,7 @@ def _form(dim: int) -> str:
     return "[x, y]" if dim == 2 else "[x, y, z]"
 
 
-def _refuse_in_3d(case: Case) -> None:
+def _refuse_in_3d(case: Any) -> None:
     """Each feature the 3D solver lacks, refused by its key (the first one met)."""
     not_yet = "not built in 3D yet (issue #39)"
     ph, st = case.physics, case.surface_tension
