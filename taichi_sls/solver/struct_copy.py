@@ -3,7 +3,7 @@
 Taichi's ``StructField.from_numpy`` and each member field's ``to_numpy`` / ``from_numpy`` copy
 member by member, each through a kernel of its own that compiles (front end and JIT) the first
 time, ~25 ms each: the materials' 40 members, the checkpoint's 19 point members both ways, the
-monitors' totals. These two kernels copy any set of members (scalars, vectors and matrices) at
+monitors' totals. One kernel copies any set of members (scalars, vectors and matrices) at
 once through a float64 table, one row per element and one column per component (exact for the
 f32, f64 and i32 members the solver's structs hold), with the same values as Taichi's.
 """
@@ -32,17 +32,34 @@ def _element(shape: ti.template(), i):
 
 
 @ti.kernel
-def _from_table(sf: ti.template(), layout: ti.template(), table: ti.types.ndarray()):
+def _copy(
+    sf: ti.template(),
+    layout: ti.template(),
+    table: ti.types.ndarray(),
+    into_table: ti.template(),
+):
     for i in range(table.shape[0]):
         if ti.static(len(sf.shape) == 0):
-            for k in ti.static(range(len(layout))):
-                name, col, comp = ti.static(layout[k])
-                _put(sf.field_dict[name], None, comp, col, table, i)
+            _row(sf, layout, None, table, i, into_table)
         else:
-            at = _element(sf.shape, i)
-            for k in ti.static(range(len(layout))):
-                name, col, comp = ti.static(layout[k])
-                _put(sf.field_dict[name], at, comp, col, table, i)
+            _row(sf, layout, _element(sf.shape, i), table, i, into_table)
+
+
+@ti.func
+def _row(
+    sf: ti.template(),
+    layout: ti.template(),
+    at: ti.template(),
+    table: ti.template(),
+    i,
+    into_table: ti.template(),
+):
+    for k in ti.static(range(len(layout))):
+        name, col, comp = ti.static(layout[k])
+        if ti.static(into_table):
+            _get(sf.field_dict[name], at, comp, col, table, i)
+        else:
+            _put(sf.field_dict[name], at, comp, col, table, i)
 
 
 @ti.func
@@ -62,20 +79,6 @@ def _put(
     else:
         for a, b in ti.static(ti.ndrange(comp[0], comp[1])):
             f[at][a, b] = ti.cast(table[i, col + a * comp[1] + b], f.dtype)
-
-
-@ti.kernel
-def _to_table(sf: ti.template(), layout: ti.template(), table: ti.types.ndarray()):
-    for i in range(table.shape[0]):
-        if ti.static(len(sf.shape) == 0):
-            for k in ti.static(range(len(layout))):
-                name, col, comp = ti.static(layout[k])
-                _get(sf.field_dict[name], None, comp, col, table, i)
-        else:
-            at = _element(sf.shape, i)
-            for k in ti.static(range(len(layout))):
-                name, col, comp = ti.static(layout[k])
-                _get(sf.field_dict[name], at, comp, col, table, i)
 
 
 @ti.func
@@ -127,7 +130,7 @@ def from_numpy(sf, arrays: Mapping[str, np.ndarray]) -> None:
     for name, col, comp in layout:
         n = int(np.prod(comp, dtype=int))
         table[:, col : col + n] = np.asarray(arrays[name], dtype=np.float64).reshape(rows, n)
-    _from_table(sf, layout, table)
+    _copy(sf, layout, table, False)
 
 
 def to_numpy(sf, keys: Iterable[str] | None = None) -> dict[str, np.ndarray]:
@@ -135,7 +138,7 @@ def to_numpy(sf, keys: Iterable[str] | None = None) -> dict[str, np.ndarray]:
     and shapes as Taichi's."""
     layout, width = _layout(sf, sf.keys if keys is None else keys)
     table = np.empty((_rows(sf), width), dtype=np.float64)
-    _to_table(sf, layout, table)
+    _copy(sf, layout, table, True)
     return {
         name: table[:, col : col + int(np.prod(comp, dtype=int))]
         .reshape(tuple(sf.shape) + comp)
