@@ -62,7 +62,7 @@ def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
 
 def neck_regions(sim: Simulation, points: np.ndarray, normals: np.ndarray) -> list[np.ndarray]:
     """Per contact, which points (in their current order) lie in its neck region."""
-    x0 = sim.state.points.x0.to_numpy()
+    x0 = sim.point_arrays(("x0",))["x0"]
     body = sim.scene.body
     half = sim.case.fusion.neck_region_cells * sim.state.cfg.h
     out = []
@@ -92,7 +92,7 @@ class ContactHistory:
 
     def add(self, sim: Simulation) -> None:
         necks = np.array(sim.pair_necks_m()) * 1e6
-        liquid = 1.0 - sim.state.points.solid_fraction.to_numpy()
+        liquid = 1.0 - sim.point_arrays(("solid_fraction",))["solid_fraction"]
         regions = neck_regions(sim, self.points, self.normals)
         self.molten_now = np.array([bool(np.any(liquid[r] > 0.0)) for r in regions], dtype=bool)
         if not self.started:
@@ -117,7 +117,7 @@ class ContactHistory:
     def rows(self, sim: Simulation) -> list[dict[str, float]]:
         """The contacts table (contacts.csv), one row per contact, with the verdict."""
         f = sim.case.fusion
-        tm = sim.state.points.time_molten.to_numpy()
+        tm = sim.point_arrays(("time_molten",))["time_molten"]
         regions = neck_regions(sim, self.points, self.normals)
         heated = laser_acted(sim.case)
         out = []
@@ -212,11 +212,9 @@ def bed_summary(
     n = len(rows)
     col = {k: np.array([r[k] for r in rows], dtype=float) for k in (*NECKS, "fused")}
     after = layer_density(sim)
-    pt = sim.state.points
+    pt = sim.point_arrays(("x0", "time_molten"))
     spacing = sim.state.cfg.h / sim.case.grid.points_per_cell
-    melt = melt_extent(
-        pt.x0.to_numpy(), pt.time_molten.to_numpy(), sim.case.top_um() * 1e-6, spacing
-    )
+    melt = melt_extent(pt["x0"], pt["time_molten"], sim.case.top_um() * 1e-6, spacing)
     rep = sim.case.bed_report() or {}
     record = {
         "contacts": n,

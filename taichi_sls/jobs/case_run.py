@@ -249,7 +249,6 @@ def run_case(
         solid = False
     finally:
         bar.close()
-        pt = sim.state.points
         arrays = sim.point_arrays()
         in_neck = neck_region(case, arrays["x0"], sc.body, arrays["mass"])
         summary["outcome"] = outcome(
@@ -271,13 +270,13 @@ def run_case(
                 rows = bed.rows(sim)
                 write_contacts(out_dir / "contacts.csv", rows)
                 summary["bed"] = bed_summary(sim, rows, bed.density_initial)
-                plot_contacts(out_dir, rows, pt.x.to_numpy() * 1e6)
+                plot_contacts(out_dir, rows, arrays["x"] * 1e6)
                 density = summary["bed"]["relative_density"]
                 plot_bed_outcome(
                     out_dir,
                     rows,
-                    pt.x.to_numpy() * 1e6,
-                    time_molten=pt.time_molten.to_numpy(),
+                    arrays["x"] * 1e6,
+                    time_molten=arrays["time_molten"],
                     density=(density["initial"], density["final"]),
                     neck_growth=case.fusion.neck_growth,
                 )
@@ -310,7 +309,7 @@ def run_case(
         writer.finish(beam_off(case) if bed is not None else None)
         try:
             if bed is None:  # a bed's outcome.png is drawn with its contacts above
-                plot_outcome(out_dir, sc.x, pt.x.to_numpy(), sc.body)
+                plot_outcome(out_dir, sc.x, sim.point_arrays()["x"], sc.body)
         except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
             print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)
     return summary
@@ -338,18 +337,18 @@ def _compiled(clock0: dict[str, float]) -> dict[str, float]:
 
 def write_layer_file(path: Path, sim: Simulation, status: str) -> None:
     """The points as they are now, for a case that deposits a layer on them (bed.previous_layer)."""
-    pt, sc = sim.state.points, sim.scene
+    pt, sc = sim.point_arrays(("x", "volume0", "J", "T", *CARRIED_STATE)), sim.scene
     write_layer(
         path,
-        x_um=pt.x.to_numpy() * 1e6,
-        volume_um2=pt.volume0.to_numpy() * pt.J.to_numpy() * 1e12,
+        x_um=pt["x"] * 1e6,
+        volume_um2=pt["volume0"] * pt["J"] * 1e12,
         body=sc.body,
         material=sc.material,
         material_names=sc.material_names,
-        T_C=pt.T.to_numpy() - KELVIN,
+        T_C=pt["T"] - KELVIN,
         info={"case": sim.case.case.name, "t_s": sim.t, "status": status},
-        volume0_um2=pt.volume0.to_numpy() * 1e12,
-        state={k: getattr(pt, k).to_numpy() for k in CARRIED_STATE},
+        volume0_um2=pt["volume0"] * 1e12,
+        state={k: pt[k] for k in CARRIED_STATE},
     )
 
 

@@ -17,7 +17,7 @@ from taichi_sls.backend import ti
 
 from .codes import Strain, StressForm, StressReading
 from .materials import lerp_phase, viscosity
-from .small_matrix import conjugate, matmul
+from .small_matrix import IDENTITY, ZERO_MATRIX, ZERO_VECTOR, conjugate, matmul, matmul_bt
 
 SQRT23 = math.sqrt(2.0 / 3.0)
 # the smallest principal elastic stretch whose logarithm is taken: a point compressed past it
@@ -28,7 +28,7 @@ STRETCH_FLOOR = 1e-6
 @ti.func
 def to3(A, dim: ti.template()):
     """A dim x dim tensor as 3x3 (plane strain: zero out-of-plane row and column)."""
-    out = ti.Matrix.zero(float, 3, 3)
+    out = ti.Matrix(ZERO_MATRIX[3, 3])
     for a, b in ti.static(ti.ndrange(dim, dim)):
         out[a, b] = A[a, b]
     return out
@@ -37,7 +37,7 @@ def to3(A, dim: ti.template()):
 @ti.func
 def embed3(e2):
     """In-plane 2x2 strain -> 3x3 with eps_zz = 0 (plane strain)."""
-    e = ti.Matrix.zero(float, 3, 3)
+    e = ti.Matrix(ZERO_MATRIX[3, 3])
     for a, b in ti.static(ti.ndrange(2, 2)):
         e[a, b] = e2[a, b]
     return e
@@ -74,7 +74,7 @@ def perzyna_update(
     E, nu = moduli(mp, xi)
     mu = E / (2.0 * (1.0 + nu))
     K = E / (3.0 * (1.0 - 2.0 * nu))
-    I3 = ti.Matrix.identity(float, 3)
+    I3 = ti.Matrix(IDENTITY[3])
     ee = eps3 - eps_pl - e_iso * I3
     tr = ee.trace()
     s = 2.0 * mu * (ee - tr / 3.0 * I3)
@@ -100,7 +100,7 @@ def perzyna_return(mp: ti.template(), s, alpha, mu, xi, T, dt):
     snorm = s.norm()
     f = snorm - SQRT23 * (sy + Hh * alpha)
     dgam = 0.0
-    n = ti.Matrix.zero(float, 3, 3)
+    n = ti.Matrix(ZERO_MATRIX[3, 3])
     if f > 0.0:
         tau = viscosity(mp, T) / (2.0 * mu)
         dgam = (f / (2.0 * mu)) / (tau / dt + 1.0 + Hh / (3.0 * mu))
@@ -138,13 +138,13 @@ def perzyna_increment(
     E, nu = moduli(mp, xi)
     mu = E / (2.0 * (1.0 + nu))
     K = E / (3.0 * (1.0 - 2.0 * nu))
-    I3 = ti.Matrix.identity(float, 3)
+    I3 = ti.Matrix(IDENTITY[3])
     de = deps3 - d_iso * I3
     tr = de.trace()
     p = sigma.trace() / 3.0 + K * tr
     s = (sigma - sigma.trace() / 3.0 * I3) + 2.0 * mu * (de - tr / 3.0 * I3)
     dgam = 0.0
-    n = ti.Matrix.zero(float, 3, 3)
+    n = ti.Matrix(ZERO_MATRIX[3, 3])
     if ti.static(plastic):
         s, dgam, n = perzyna_return(mp, s, alpha, mu, xi, T, dt)
     return p * I3 + s, dgam, n
@@ -163,7 +163,7 @@ def principal_frame(b, dim: ti.template()):
     b. Plane strain (dim 2): the in-plane 2x2 block in closed form, angle from atan2 (exact for
     near-equal eigenvalues; ti.svd's 2x2 treats an off-diagonal below 1e-5 as zero, which erased
     small elastic shears step after step) and b_zz as the third; dim 3: ti.sym_eig."""
-    Q = ti.Matrix.identity(float, 3)
+    Q = ti.Matrix(IDENTITY[3])
     ev = ti.Vector([b[0, 0], b[1, 1], b[2, 2]])
     if ti.static(dim == 2):
         half = 0.5 * (b[0, 0] - b[1, 1])
@@ -210,9 +210,9 @@ def hencky_update(
     a difference of order d(xi) dt. Then s_tr = 2 mu dev(e), the Perzyna correction of eqs.
     40-45 on the Kirchhoff deviator, tau = s + K tr(e) 1 and sigma = Q tau Q^T / J."""
     mu, K = bulk_shear(mp, xi)
-    b = matmul(matmul(matmul(f, Fe), Fe.transpose()), f.transpose())  # f Fe Fe^T f^T, as @
+    b = matmul_bt(matmul_bt(matmul(f, Fe), Fe), f)  # f Fe Fe^T f^T, as @
     ev, Q = principal_frame(b, dim)
-    e = ti.Vector.zero(float, 3)
+    e = ti.Vector(ZERO_VECTOR[3])
     for i in ti.static(range(3)):
         e[i] = 0.5 * ti.log(ti.max(ev[i], STRETCH_FLOOR * STRETCH_FLOOR)) - d_iso
     e_vol = e.sum()
@@ -221,15 +221,15 @@ def hencky_update(
         mu0, K0 = bulk_shear(mp, xi_last)
         e_dev *= mu0 / mu
         e_vol *= K0 / K
-    s = ti.Matrix.zero(float, 3, 3)
+    s = ti.Matrix(ZERO_MATRIX[3, 3])
     for i in ti.static(range(3)):
         s[i, i] = 2.0 * mu * e_dev[i]
     dgam = 0.0
-    n = ti.Matrix.zero(float, 3, 3)
+    n = ti.Matrix(ZERO_MATRIX[3, 3])
     if ti.static(plastic):
         s, dgam, n = perzyna_return(mp, s, alpha, mu, xi, T, dt)
-    tau = ti.Matrix.zero(float, 3, 3)
-    lam = ti.Matrix.zero(float, 3, 3)
+    tau = ti.Matrix(ZERO_MATRIX[3, 3])
+    lam = ti.Matrix(ZERO_MATRIX[3, 3])
     for i in ti.static(range(3)):
         tau[i, i] = s[i, i] + K * e_vol
         lam[i, i] = ti.exp(s[i, i] / (2.0 * mu) + e_vol / 3.0)
@@ -242,7 +242,7 @@ def solvent_stress(mp: ti.template(), L, xi):
     plane (``materials.*.solvent_viscosity_Pa_s``): a force term only, outside the elastic
     state, so it damps without entering the stress history."""
     D = 0.5 * (L + L.transpose())
-    dev = D - D.trace() / 3.0 * ti.Matrix.identity(float, L.n)
+    dev = D - D.trace() / 3.0 * ti.Matrix(IDENTITY[L.n])
     return 2.0 * mp.solvent_viscosity_Pa_s * (1.0 - xi) * dev
 
 
@@ -314,7 +314,7 @@ def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, 
     (:func:`hencky_update`) or small (:func:`small_strain_update`); with a solvent viscosity
     also its stress (force only)."""
     if ti.static(cfg.strain == Strain.FINITE):
-        I3 = ti.Matrix.identity(float, 3)  # f_zz = 1: plane strain
+        I3 = ti.Matrix(IDENTITY[3])  # f_zz = 1: plane strain
         sig, Fe, dgam, n = _finite_step(cfg, pt, mat, p, I3 + dt * to3(L, cfg.dim), pt.J[p], dt)
         pt.stress[p] = sig
         pt.elastic_stretch[p] = Fe
@@ -364,11 +364,11 @@ def trial_stress(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L
     mp = mat[pt.material[p]]
     xi = pt.solid_fraction[p]
     mu, K = bulk_shear(mp, xi)
-    sig3 = ti.Matrix.zero(float, 3, 3)
+    sig3 = ti.Matrix(ZERO_MATRIX[3, 3])
     dgam = 0.0
     kirchhoff = 1.0  # the return map acts on the Kirchhoff deviator J s in finite strain
     if ti.static(cfg.strain == Strain.FINITE):
-        f = ti.Matrix.identity(float, 3) + dt * to3(L, cfg.dim)
+        f = ti.Matrix(IDENTITY[3]) + dt * to3(L, cfg.dim)
         J = pt.J[p] * f.determinant()
         sig3, Fe, dgam, n = _finite_step(cfg, pt, mat, p, f, J, dt)
         kirchhoff = J
@@ -382,14 +382,14 @@ def trial_stress(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, L
     ratio = 1.0
     if dgam > 0.0:
         tau = kirchhoff * sig3
-        s_norm = (tau - tau.trace() / 3.0 * ti.Matrix.identity(float, 3)).norm()
+        s_norm = (tau - tau.trace() / 3.0 * ti.Matrix(IDENTITY[3])).norm()
         ratio = s_norm / (s_norm + 2.0 * mu * dgam)
     elif ti.static(cfg.plastic):
         # no flow at this trial: elastic, unless the yield stress is zero and the trial deviator
         # is (a melt at rest), where the secant is the flow's limit, not mu: the implicit step
         # keeps the tangent of its first iterate, v^n, over its Newton iterations
         ratio = perzyna_secant_at_zero(mp, pt.equivalent_plastic_strain[p], mu, xi, pt.T[p], dt)
-    sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    sig = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
     for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
         sig[a, b] = sig3[a, b]
     eta = 0.0

@@ -13,6 +13,7 @@ from .codes import NodeFlag
 from .curvature import curvature, extend_and_smooth
 from .grid import active, ramped_gamma
 from .level_set import blur_level_set, level_set
+from .small_matrix import ZERO_VECTOR
 
 CURVATURE = int(NodeFlag.CURVATURE)
 INTERFACE = int(NodeFlag.INTERFACE)
@@ -32,7 +33,7 @@ def mass_gradient(cfg: ti.template(), box: ti.template(), nd: ti.template()):
     """Eq. 20 with the uGIMP gradient at node positions; flags interface nodes."""
     S, dS = ti.static(_node_stencil_1d(cfg.h, cfg.lp))
     for i, j in ti.ndrange(*active(box)):
-        g = ti.Vector.zero(float, 2)
+        g = ti.Vector(ZERO_VECTOR[2])
         if i > 0 and j > 0 and i < cfg.nx - 1 and j < cfg.ny - 1:
             for a, b in ti.static(ti.ndrange(3, 3)):
                 m = nd.mass[i + a - 1, j + b - 1]
@@ -60,7 +61,7 @@ def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: t
     full = cfg.rho_ref * cfg.cell_volume
     coef = ramped_gamma(cfg, t) / (cfg.rho_ref * (1.0 - c0) * (1.0 - c0))
     if ti.static(cfg.zero_net_force):
-        surf.resultant[None] = ti.Vector.zero(float, 3)
+        surf.resultant[None] = ti.Vector(ZERO_VECTOR[3])
     for i, j in ti.ndrange(*active(box)):
         if nd.flags[i, j] & INTERFACE:
             wc = 2.0 * ti.max(nd.mass[i, j] / full - c0, 0.0)

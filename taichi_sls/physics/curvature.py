@@ -20,6 +20,7 @@ from taichi_sls.backend import ti
 
 from .codes import NodeFlag
 from .grid import active
+from .small_matrix import ZERO_VECTOR
 
 CURVATURE = int(NodeFlag.CURVATURE)
 INTERFACE = int(NodeFlag.INTERFACE)
@@ -48,7 +49,7 @@ def curvature(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: t
         k = 0.0
         ok = 0
         if i > 0 and j > 0 and i < cfg.nx - 1 and j < cfg.ny - 1:
-            f9 = ti.Vector.zero(float, 9)
+            f9 = ti.Vector(ZERO_VECTOR[9])
             inband = 1
             for a, b in ti.static(ti.ndrange(3, 3)):
                 v = nd.phi_smooth[i + a - 1, j + b - 1]

@@ -24,8 +24,8 @@ from .grid import active, scatter_min
 def scatter_level_set(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base):
     """Eq. 21 onto the 5x5 nodes around point p (base: its 3x3 stencil origin)."""
     xp = pt.x[p]
-    for a, b in ti.static(ti.ndrange(5, 5)):
-        I = base + ti.Vector([a - 1, b - 1])
+    for o in ti.grouped(ti.ndrange(5, 5)):  # at run time: one copy of the body (compile time)
+        I = base + o - 1
         xi = ti.cast(I - cfg.off, float) * cfg.h
         scatter_min(cfg, nd.phi_raw, I, (xi - xp).norm() - cfg.r_p)
 

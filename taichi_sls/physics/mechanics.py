@@ -31,6 +31,7 @@ from taichi_sls.backend import ti
 from .codes import Transfer, WallMechanical
 from .grid import node_x, scatter_add
 from .shape import STENCIL_SHAPE, node_weight
+from .small_matrix import IDENTITY, ZERO_MATRIX, ZERO_VECTOR
 
 
 @ti.func
@@ -52,7 +53,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
     mi = inertia(cfg, mp)
     vp = pt.v[p]
     Vp = pt.volume0[p] * pt.J[p]
-    sig = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    sig = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
     if ti.static(not cfg.implicit):  # implicit: the internal force of the new stress instead
         for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
             sig[a, b] = pt.stress[p][a, b]
@@ -67,7 +68,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
             mv += pt.C[p] @ (node_x(cfg, I) - xp)
         scatter_add(cfg, nd.mass, I, N * mi)
         scatter_add(cfg, nd.momentum, I, N * mi * mv)
-        f = ti.Vector.zero(float, cfg.dim)
+        f = ti.Vector(ZERO_VECTOR[cfg.dim])
         if ti.static(not cfg.implicit):
             f = -Vp * (sig @ gN)
         if ti.static(cfg.has_gravity):
@@ -87,12 +88,12 @@ def apply_walls(cfg: ti.template(), I, v):
             if ti.static(kind_lo == WallMechanical.SLIP):
                 v[d] = 0.0
             elif ti.static(kind_lo == WallMechanical.STICK):
-                v = ti.Vector.zero(float, cfg.dim)
+                v = ti.Vector(ZERO_VECTOR[cfg.dim])
         if I[d] >= hi[d]:
             if ti.static(kind_hi == WallMechanical.SLIP):
                 v[d] = 0.0
             elif ti.static(kind_hi == WallMechanical.STICK):
-                v = ti.Vector.zero(float, cfg.dim)
+                v = ti.Vector(ZERO_VECTOR[cfg.dim])
     return v
 
 
@@ -100,8 +101,8 @@ def apply_walls(cfg: ti.template(), I, v):
 def grid_velocity(cfg: ti.template(), nd: ti.template(), I, dt):
     """v^n = (mv)/m and v^{n+1} = v^n + dt f / m (eqs. 10, 13); nodes below the cut-off rest."""
     m = nd.mass[I]
-    vn = ti.Vector.zero(float, cfg.dim)
-    v = ti.Vector.zero(float, cfg.dim)
+    vn = ti.Vector(ZERO_VECTOR[cfg.dim])
+    v = ti.Vector(ZERO_VECTOR[cfg.dim])
     if m > cfg.mass_cut:
         vn = nd.momentum[I] / m
         v = apply_walls(cfg, I, vn + dt * nd.force[I] / m)
@@ -113,9 +114,9 @@ def grid_velocity(cfg: ti.template(), nd: ti.template(), I, dt):
 def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
     """The point velocity from the grid (transfer variant; eq. 14 for FLIP)."""
     xp = pt.x[p]
-    v_pic = ti.Vector.zero(float, cfg.dim)
-    dv = ti.Vector.zero(float, cfg.dim)
-    B = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    v_pic = ti.Vector(ZERO_VECTOR[cfg.dim])
+    dv = ti.Vector(ZERO_VECTOR[cfg.dim])
+    B = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         I = base + o
@@ -146,8 +147,8 @@ def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
 @ti.func
 def interpolate_velocity(cfg: ti.template(), nd: ti.template(), base, w, dw):
     """The grid velocity at a point and its gradient L = sum_i v_i grad N_i (eq. 16)."""
-    v_grid = ti.Vector.zero(float, cfg.dim)
-    L = ti.Matrix.zero(float, cfg.dim, cfg.dim)
+    v_grid = ti.Vector(ZERO_VECTOR[cfg.dim])
+    L = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
         N, gN = node_weight(w, dw, o)
         vi = nd.v[base + o]
@@ -164,7 +165,7 @@ def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
     """
     v_grid, L = interpolate_velocity(cfg, nd, base, w, dw)
     pt.x[p] += dt * v_grid
-    F = (ti.Matrix.identity(float, cfg.dim) + dt * L) @ pt.F[p]
+    F = (ti.Matrix(IDENTITY[cfg.dim]) + dt * L) @ pt.F[p]
     pt.F[p] = F
     pt.J[p] = F.determinant()
     return L
@@ -187,7 +188,7 @@ def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
 @ti.func
 def grid_remap_velocity(cfg: ti.template(), nd: ti.template(), I):
     """MUSL: the grid velocity from the remapped momenta, walls applied; empty nodes rest."""
-    v = ti.Vector.zero(float, cfg.dim)
+    v = ti.Vector(ZERO_VECTOR[cfg.dim])
     if nd.mass[I] > cfg.mass_cut:
         v = apply_walls(cfg, I, nd.momentum[I] / nd.mass[I])
     nd.v[I] = v

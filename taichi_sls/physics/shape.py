@@ -7,6 +7,8 @@ closer than h + l_p. With node spacing h that is at most three nodes per axis, s
 
 from taichi_sls.backend import ti
 
+from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
+
 # Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
 # surface tension and output are 2D (plane strain) for now.
 DIM = 2
@@ -37,6 +39,12 @@ def gimp_1d(xi, h, lp):
 
 
 @ti.func
+def stencil_base(xp, inv_h, origin_idx):
+    """The base node index of :func:`stencil` alone."""
+    return ti.cast(ti.floor(xp * inv_h + 0.5), ti.i32) - 1 + origin_idx
+
+
+@ti.func
 def stencil(xp, inv_h, h, lp, origin_idx):
     """Base node index and the 3x3 tensor-product weights / gradients for point position xp.
 
@@ -46,12 +54,13 @@ def stencil(xp, inv_h, h, lp, origin_idx):
     """
     dim = ti.static(xp.n)
     base = ti.Vector.zero(ti.i32, dim)
-    w = ti.Matrix.zero(float, 3, dim)
-    dw = ti.Matrix.zero(float, 3, dim)
-    for d in ti.static(range(dim)):
+    w = ti.Matrix(ZERO_MATRIX[3, dim])
+    dw = ti.Matrix(ZERO_MATRIX[3, dim])
+    # both loops at run time: one copy of gimp_1d, not 3 dim (the front end's cost)
+    for d in range(dim):
         f = xp[d] * inv_h
         base[d] = ti.cast(ti.floor(f + 0.5), ti.i32) - 1
-        for a in range(3):  # at run time: one copy of gimp_1d, not 3 dim (the front end's cost)
+        for a in range(3):
             xi = (f - ti.cast(base[d] + a, float)) * h
             s, ds = gimp_1d(xi, h, lp)
             w[a, d] = s
@@ -65,13 +74,14 @@ def node_weight(w, dw, offs):
     """N and grad N of the stencil node at static offset ``offs`` (tensor product, any dim)."""
     dim = ti.static(w.m)
     n = 1.0 + 0.0 * w[0, 0]
-    g = ti.Vector.zero(float, dim)
-    for d in ti.static(range(dim)):
+    g = ti.Vector(ZERO_VECTOR[dim])
+    # run-time loops (the products in the same order): one copy of each body per call site
+    for d in range(dim):
         n *= w[offs[d], d]
-    for d in ti.static(range(dim)):
+    for d in range(dim):
         gd = dw[offs[d], d]
-        for e in ti.static(range(dim)):
-            if ti.static(e != d):
+        for e in range(dim):
+            if e != d:
                 gd *= w[offs[e], e]
         g[d] = gd
     return n, g

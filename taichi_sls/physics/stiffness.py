@@ -26,6 +26,7 @@ gathers it into a sparse matrix.
 from taichi_sls.backend import ti
 
 from .shape import node_weight, stencil
+from .small_matrix import ZERO_MATRIX
 from .surface_energy import GAUSS, outline_segments
 
 REACH = 2  # nodes of one row lie within REACH of the diagonal node along every axis
@@ -38,7 +39,7 @@ def stencil_gradients(w, dw):
     fastest): the pair loops below run over them at run time, so that they compile as one loop
     body instead of 81 unrolled ones."""
     dim = ti.static(w.m)
-    G = ti.Matrix.zero(float, 3**dim, dim)
+    G = ti.Matrix(ZERO_MATRIX[3**dim, dim])
     for k in range(3**dim):
         N, g = node_weight(w, dw, stencil_offset(k, dim))
         for d in ti.static(range(dim)):

@@ -39,6 +39,7 @@ from taichi_sls.backend import ti
 from .contour import cell_segments
 from .grid import active, ramped_gamma, scatter_add
 from .shape import STENCIL_SHAPE, node_weight, stencil
+from .small_matrix import ZERO_VECTOR
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
 
@@ -80,8 +81,8 @@ def colour_field(cfg: ti.template(), box: ti.template(), nd: ti.template()):
         c = 0.0
         if ti.static(cfg.se.filter):
             if i > 0 and j > 0 and i < cfg.nx - 1 and j < cfg.ny - 1:
-                for a, b in ti.static(ti.ndrange(3, 3)):
-                    wa = ti.static((0.25, 0.5, 0.25)[a] * (0.25, 0.5, 0.25)[b])
+                for a, b in ti.ndrange(3, 3):  # at run time: one copy of the body
+                    wa = (0.5 - 0.25 * ti.abs(a - 1)) * (0.5 - 0.25 * ti.abs(b - 1))
                     c += wa * raw_colour(cfg, nd, ti.Vector([i + a - 1, j + b - 1]))
         else:
             c = raw_colour(cfg, nd, ti.Vector([i, j]))
@@ -133,8 +134,8 @@ def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), s
         scatter_add(cfg, nd.force, I, f)
     elif f.norm_sqr() > 0.0:
         M = 0.0
-        for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
-            if ti.static(o[0] != 0 or o[1] != 0):
+        for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2))):  # at run time: one copy
+            if o[0] != 0 or o[1] != 0:
                 M += nd.mass[I + o]
         keep = m / cfg.se.floor_mass
         if M <= 0.0:
@@ -142,8 +143,8 @@ def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), s
         scatter_add(cfg, nd.force, I, keep * f)
         if M > 0.0:
             rest = (1.0 - keep) / M * f
-            for o in ti.static(ti.grouped(ti.ndrange((-1, 2), (-1, 2)))):
-                if ti.static(o[0] != 0 or o[1] != 0):
+            for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2))):
+                if o[0] != 0 or o[1] != 0:
                     scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
 
 
@@ -228,7 +229,7 @@ def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template
     """The outline of the colour field and its surface-energy force, added to nd.force."""
     if ti.static(cfg.se.spread):
         for I in ti.grouped(ti.ndrange(*active(box))):
-            nd.surface_force[I] = ti.Vector.zero(float, 2)
+            nd.surface_force[I] = ti.Vector(ZERO_VECTOR[2])
     colour_field(cfg, box, nd)
     outline_segments(cfg, box, nd, segment_force, nd, ramped_gamma(cfg, t))
     if ti.static(cfg.se.spread):

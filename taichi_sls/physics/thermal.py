@@ -54,6 +54,7 @@ from .materials import (
     temperature_from_enthalpy_history,
 )
 from .shape import STENCIL_SHAPE, node_weight
+from .small_matrix import ZERO_VECTOR
 
 
 @ti.func
@@ -134,7 +135,7 @@ def p2g_heat_flux(
     """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate;
     with the sub-grid filter on, the point's deviation from the grid temperature too. Returns
     the laser energy the point took (J/m)."""
-    gT = ti.Vector.zero(float, cfg.dim)
+    gT = ti.Vector(ZERO_VECTOR[cfg.dim])
     T_grid = 0.0
     w_fixed = 0.0
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):

@@ -18,6 +18,7 @@ time, nor a time the caller asks to land on (a frame). A step cut short to land 
 shrink the next one.
 """
 
+import enum
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ import numpy as np
 from taichi_sls.backend import ti
 
 from ..config import Case
+from ..physics.small_matrix import IDENTITY
 from . import checkpoint
 from .fields import POINT_MEMBERS, State, struct_type
 from .guard import SimulationError
@@ -84,27 +86,49 @@ def laser_switch_times(case: Case) -> list[float]:
 
 
 @ti.kernel
-def copy_points(src: ti.template(), dst: ti.template()):
-    for p in src:
-        dst[p] = src[p]
+def copy_points(a: ti.template(), b: ti.template(), into_b: ti.i32):
+    """b = a (``into_b``) or a = b: one kernel both ways (a template each way would be two)."""
+    for p in a:
+        if into_b:
+            b[p] = a[p]
+        else:
+            a[p] = b[p]
+
+
+class PointsPass(enum.IntEnum):
+    """What :func:`points_pass` does with the points and their copy from before the step."""
+
+    SAVE = 0  # before = now
+    RESTORE = 1  # now = before
+    CHANGES = 2  # the step's changes, :func:`points_pass`
 
 
 @ti.kernel
-def step_changes(now: ti.template(), before: ti.template(), out: ti.template(), dt: float):
-    """out = (dT, de, dx, dp): the largest temperature change (K), strain increment
-    |F F_before^-1 - I| (Frobenius), motion (m) and equivalent plastic strain increment of any
-    point over the step dt since ``before``; the motion also as the point's own velocity times
-    dt, which the guard limits (with FLIP it is not the grid velocity that moved the point)."""
-    out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+def points_pass(
+    now: ti.template(), before: ti.template(), out: ti.template(), dt: float, what: ti.i32
+):
+    """As ``what`` (:class:`PointsPass`) says: save the points, put them back, or out = (dT,
+    de, dx, dp): the largest temperature change (K), strain increment |F F_before^-1 - I|
+    (Frobenius), motion (m) and equivalent plastic strain increment of any point over the step
+    dt since ``before``; the motion also as the point's own velocity times dt, which the guard
+    limits (with FLIP it is not the grid velocity that moved the point). One kernel for the
+    three (a kernel's compilation costs tens of ms whatever its size)."""
+    if what == PointsPass.CHANGES:
+        out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0])
     for p in now:
-        f = now[p].F @ before[p].F.inverse()
-        f -= ti.Matrix.identity(float, f.n)
-        ti.atomic_max(out[None][0], ti.abs(now[p].T - before[p].T))
-        ti.atomic_max(out[None][1], ti.sqrt((f * f).sum()))
-        dx = ti.max((now[p].x - before[p].x).norm(), now[p].v.norm() * dt)
-        ti.atomic_max(out[None][2], dx)
-        dp = now[p].equivalent_plastic_strain - before[p].equivalent_plastic_strain
-        ti.atomic_max(out[None][3], dp)
+        if what == PointsPass.SAVE:
+            before[p] = now[p]
+        elif what == PointsPass.RESTORE:
+            now[p] = before[p]
+        else:
+            f = now[p].F @ before[p].F.inverse()
+            f -= ti.Matrix(IDENTITY[f.n])
+            ti.atomic_max(out[None][0], ti.abs(now[p].T - before[p].T))
+            ti.atomic_max(out[None][1], ti.sqrt((f * f).sum()))
+            dx = ti.max((now[p].x - before[p].x).norm(), now[p].v.norm() * dt)
+            ti.atomic_max(out[None][2], dx)
+            dp = now[p].equivalent_plastic_strain - before[p].equivalent_plastic_strain
+            ti.atomic_max(out[None][3], dp)
 
 
 class AdaptiveStepper:
@@ -141,9 +165,16 @@ class AdaptiveStepper:
         """Compile the kernels that judge a step (they change nothing the run reads before the
         next step writes it), and the copy back that a refused step makes, so that the first
         step does not pay for them."""
-        copy_points(self.st.points, self.before)
-        copy_points(self.before, self.st.points)
+        self.save()
+        self.points_pass(PointsPass.RESTORE)
         self.changes_ratio(self.dt)
+
+    def points_pass(self, what: PointsPass, dt: float = 0.0) -> None:
+        points_pass(self.st.points, self.before, self.changes, dt, what)
+
+    def save(self) -> None:
+        """Keep the points as they are (:attr:`before`)."""
+        self.points_pass(PointsPass.SAVE)
 
     def set_step(self, dt: float) -> None:
         """Make the next step ``dt`` long, its heat substeps at most heat_step_max."""
@@ -158,7 +189,7 @@ class AdaptiveStepper:
     def changes_ratio(self, dt: float) -> float:
         """The changes of the points since :attr:`before` (over dt), as a multiple of the
         controls: the largest of dT / dT_max, de / de_max and dx / (cells h)."""
-        step_changes(self.st.points, self.before, self.changes, dt)
+        self.points_pass(PointsPass.CHANGES, dt)
         dT, de, dx, dp = (float(x) for x in self.changes[None])
         c = self.controls
         strain = dp if c.plastic else de
@@ -176,7 +207,7 @@ class AdaptiveStepper:
             dt = self._limit(t, t_end)
             cut = dt < self.dt
             before = checkpoint.capture(st, points=False)
-            copy_points(st.points, self.before)
+            self.save()
             self.set_step(dt)
             try:
                 self.implicit.step()
@@ -204,7 +235,7 @@ class AdaptiveStepper:
 
     def _redo(self, before: dict[str, np.ndarray], dt: float, smaller: float, why: str) -> None:
         """Put the state back and make the next try ``smaller``; below dt_min, give up."""
-        copy_points(self.before, self.st.points)
+        self.points_pass(PointsPass.RESTORE)
         checkpoint.restore(self.st, before)
         init_box(self.st)
         self.refused += 1

@@ -96,11 +96,11 @@ class ExtrapolatedStepper:
         st, sc = self.st, self.st.scalars
         dt, dt_heat = float(sc.dt[None]), float(sc.dt_heat[None])
         before = checkpoint.capture(st, points=False)
-        copy_points(st.points, self.start)
+        copy_points(st.points, self.start, True)
         try:
             self.inner.step()
-            copy_points(st.points, self.whole)
-            copy_points(self.start, st.points)
+            copy_points(st.points, self.whole, True)
+            copy_points(st.points, self.start, False)
             checkpoint.restore(st, before)
             init_box(st)
             sc.dt[None], sc.dt_heat[None] = 0.5 * dt, 0.5 * dt_heat

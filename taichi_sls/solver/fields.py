@@ -34,6 +34,7 @@ from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix
 from ..physics.laser import laser_struct
 from ..physics.materials import KELVIN, enthalpy, material_struct, solid_fraction
+from ..physics.small_matrix import IDENTITY, ZERO_MATRIX
 from ..physics.stiffness import WIDTH
 from . import struct_copy
 from .scene import Scene
@@ -110,6 +111,11 @@ NODE_MEMBERS = {
 }
 
 
+# the node members the host ever copies (the level-set fill, checkpoints, the neck measures):
+# the nodes' copy kernels range over these alone (solver/struct_copy.py)
+NODE_COPIES = ("phi_raw", "phi", "phi_smooth", "kappa", "flags", "colour", "mass", "volume")
+
+
 def struct_type(members: dict[str, str], dim: int):
     """A Taichi struct type from member kinds (after ti.init: ``float`` is the precision)."""
     kinds = {
@@ -149,13 +155,21 @@ class ImplicitFields:
         self.fixed = ti.field(float, rows)
         self.tangent = ti.field(float, rows)
         self.internal = ti.Vector.field(cfg.dim, float, grid)
-        self.free = ti.Vector.field(cfg.dim, ti.i32, grid)
-        self.dof = ti.Vector.field(cfg.dim, ti.i32, grid)
         self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
+        # which nodes are unknowns and their numbers, one struct: the host reads the kinds and
+        # writes the numbers through one copy kernel each way (solver/struct_copy.py)
+        numbering = {
+            "free": ti.types.vector(cfg.dim, ti.i32),
+            "dof": ti.types.vector(cfg.dim, ti.i32),
+        }
         if cfg.heat_implicit:  # backward-Euler heat (solver/implicit_heat.py)
             self.conductance = ti.field(float, grid + (WIDTH,) * cfg.dim)
-            self.heat_node = ti.field(ti.i32, grid)  # physics.codes.HeatNode
-            self.heat_dof = ti.field(ti.i32, grid)  # a free node's unknown (-1: none)
+            numbering["heat_node"] = ti.i32  # physics.codes.HeatNode
+            numbering["heat_dof"] = ti.i32  # a free node's unknown (-1: none)
+        self.numbering = ti.types.struct(**numbering).field(shape=grid, layout=ti.Layout.SOA)
+        self.free, self.dof = self.numbering.free, self.numbering.dof
+        if cfg.heat_implicit:
+            self.heat_node, self.heat_dof = self.numbering.heat_node, self.numbering.heat_dof
 
 
 @ti.data_oriented
@@ -179,6 +193,7 @@ class State:
         self.nodes = struct_type(NODE_MEMBERS, cfg.dim).field(
             shape=(cfg.nx, cfg.ny), layout=ti.Layout.SOA
         )
+        struct_copy.copies_among(self.nodes, NODE_COPIES)
         self.scalars = ti.types.struct(
             t=float,
             step=ti.i32,
@@ -196,6 +211,10 @@ class State:
         self.box = ti.Vector.field(4, ti.i32, ())  # active region [i0, j0, i1, j1)
         self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())
         self.implicit = ImplicitFields(cfg) if cfg.implicit else None
+        structs = [self.points, self.nodes, self.scalars, self.materials, self.lasers, self.totals]
+        if self.implicit is not None:
+            structs.append(self.implicit.numbering)
+        struct_copy.share_kernel(*structs)  # one copy kernel for all of them
         self._fill(materials, lasers)
 
     @property
@@ -222,9 +241,7 @@ class State:
         self.scalars.T_peak[None] = float(np.max(sc.T0_C + KELVIN))
         for k in WATCHED:
             getattr(self.scalars, f"first_{k}")[None] = NEVER
-        self._init_points()
-        if np.any(sc.p0 != 0.0):
-            self._prestress(sc.p0)
+        self._init_points(np.ascontiguousarray(sc.p0, dtype=np.float64))
         if sc.carried is not None:  # a previous layer's points keep their deformation and stress
             now = struct_copy.to_numpy(pt, sc.carried_state.keys())
             for name, values in sc.carried_state.items():
@@ -232,45 +249,48 @@ class State:
             struct_copy.from_numpy(pt, now)
 
     @ti.kernel
-    def _init_points(self):
+    def _init_points(self, p0: ti.types.ndarray()):
+        """Each point's initial state: undeformed, unstressed, its enthalpy and solid fraction
+        at its temperature; prestressed where p0 (Pa) is not zero (:meth:`_prestress`). One
+        kernel for both (a kernel's compilation costs tens of ms whatever its size)."""
         pt = ti.static(self.points)
         for p in range(self.cfg.n_points):
-            pt.F[p] = ti.Matrix.identity(float, self.cfg.dim)
+            pt.F[p] = ti.Matrix(IDENTITY[self.cfg.dim])
             pt.J[p] = 1.0
-            pt.C[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
-            pt.strain[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
-            pt.plastic_strain[p] = ti.Matrix.zero(float, 3, 3)
-            pt.stress[p] = ti.Matrix.zero(float, 3, 3)
-            pt.elastic_stretch[p] = ti.Matrix.identity(float, 3)
-            pt.viscous_stress[p] = ti.Matrix.zero(float, self.cfg.dim, self.cfg.dim)
+            pt.C[p] = ti.Matrix(ZERO_MATRIX[self.cfg.dim, self.cfg.dim])
+            pt.strain[p] = ti.Matrix(ZERO_MATRIX[self.cfg.dim, self.cfg.dim])
+            pt.plastic_strain[p] = ti.Matrix(ZERO_MATRIX[3, 3])
+            pt.stress[p] = ti.Matrix(ZERO_MATRIX[3, 3])
+            pt.elastic_stretch[p] = ti.Matrix(IDENTITY[3])
+            pt.viscous_stress[p] = ti.Matrix(ZERO_MATRIX[self.cfg.dim, self.cfg.dim])
             pt.equivalent_plastic_strain[p] = 0.0
             pt.iso_strain[p] = 0.0
             pt.iso_strain_step[p] = 0.0
             pt.enthalpy[p] = enthalpy(self.materials[pt.material[p]], pt.T[p])
             pt.solid_fraction[p] = solid_fraction(self.materials[pt.material[p]], pt.T[p])
             pt.stress_phase[p] = pt.solid_fraction[p]
+            if p0[p] != 0.0:
+                self._prestress(p, p0[p])
 
-    @ti.kernel
-    def _prestress(self, p0: ti.types.ndarray()):
+    @ti.func
+    def _prestress(self, p, p0):
         """The elastic strain that carries an in-plane pressure p0 (plane strain, eps_zz = 0:
-        eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at each point's initial moduli, and its stress
+        eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at the point's initial moduli, and its stress
         under the case's stress reading; finite strain: the elastic stretch Fe = exp(eps) of the
         same strain, whose Hencky stress at J = 1 is the same."""
         pt = ti.static(self.points)
-        for p in range(self.cfg.n_points):
-            if p0[p] != 0.0:
-                mp = self.materials[pt.material[p]]
-                xi = pt.solid_fraction[p]
-                E, nu = moduli(mp, xi)
-                lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
-                eps = ti.Matrix.identity(float, self.cfg.dim) * (-p0[p] / (2.0 * lam_mu))
-                pt.strain[p] = eps
-                for a in ti.static(range(self.cfg.dim)):
-                    pt.elastic_stretch[p][a, a] = ti.exp(eps[a, a])
-                z = ti.Matrix.zero(float, 3, 3)
-                pt.stress[p] = perzyna_update(
-                    mp, embed3(eps), z, 0.0, 0.0, xi, pt.T[p], 1.0, False, self.cfg.stress_reading
-                )[0]
+        mp = self.materials[pt.material[p]]
+        xi = pt.solid_fraction[p]
+        E, nu = moduli(mp, xi)
+        lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
+        eps = ti.Matrix(IDENTITY[self.cfg.dim]) * (-p0 / (2.0 * lam_mu))
+        pt.strain[p] = eps
+        for a in ti.static(range(self.cfg.dim)):
+            pt.elastic_stretch[p][a, a] = ti.exp(eps[a, a])
+        z = ti.Matrix(ZERO_MATRIX[3, 3])
+        pt.stress[p] = perzyna_update(
+            mp, embed3(eps), z, 0.0, 0.0, xi, pt.T[p], 1.0, False, self.cfg.stress_reading
+        )[0]
 
     def node_position(self, i: int, j: int) -> tuple[float, float]:
         return ((i - self.cfg.off) * self.cfg.h, (j - self.cfg.off) * self.cfg.h)

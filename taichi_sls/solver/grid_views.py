@@ -7,15 +7,21 @@ from taichi_sls.backend import ti
 from ..physics.grid import active
 from ..physics.level_set import level_set, scatter_level_set
 from ..physics.surface_energy import colour_field
-from .loops import point_loop
-from .step import STAGES, SURFACE, grow_box_all, p2g, point_stencil
+from .loops import point_base, point_loop
+from .step import STAGES, SURFACE, grow_box_all, p2g
 
 
 @ti.kernel
-def level_set_only(st: ti.template()):
-    """The level set of eq. 21 of the current points, for monitors (also with surface tension
-    off). Leaves the curvature the step keeps between rebuilds untouched."""
+def interface_fields(st: ti.template()):
+    """The level set of eq. 21 and the surface-energy colour (nodes.phi, nodes.colour) of the
+    current points, for monitors (also with surface tension off): one kernel for both (a
+    kernel's compilation costs tens of ms whatever its size). The colour: the step's stages up
+    to P2G without heat or geometry, then the colour (filtered as the case says). Leaves the
+    curvature the step keeps between rebuilds untouched."""
     grow_box_all(st)
+    for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
+        stage(st, False, False)
+    colour_field(st.cfg, st.box, st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         st.nodes.phi_raw[I] = st.cfg.phi_cap
     point_loop(st, _level_set_body, False, True, True)
@@ -24,17 +30,7 @@ def level_set_only(st: ti.template()):
 
 @ti.func
 def _level_set_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
-    base, w, dw = point_stencil(st.cfg, st.points, p)
-    scatter_level_set(st.cfg, st.points, st.nodes, p, base)
-
-
-@ti.kernel
-def colour_only(st: ti.template()):
-    """The surface-energy colour of the current points (nodes.colour), for monitors: the step's
-    stages up to P2G without heat or geometry, then the colour (filtered as the case says)."""
-    for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
-        stage(st, False, False)
-    colour_field(st.cfg, st.box, st.nodes)
+    scatter_level_set(st.cfg, st.points, st.nodes, p, point_base(st.cfg, st.points, p))
 
 
 @ti.kernel

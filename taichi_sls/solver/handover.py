@@ -27,8 +27,11 @@ import copy
 import math
 from collections.abc import Callable
 
+import numpy as np
+
 from ..config import Case
-from .adaptive import AdaptiveStepper, copy_points, next_step
+from . import struct_copy
+from .adaptive import AdaptiveStepper, next_step
 from .fields import State
 from .scene import Scene
 from .step_config import step_config
@@ -116,7 +119,8 @@ class Handover:
     def hand_over(self, t: float) -> None:
         """The implicit step takes over at t (the rule's, or contact.settle_steps = "implicit"
         from the start)."""
-        self.adaptive.st.points.iso_strain_step.fill(0.0)
+        pt = self.adaptive.st.points
+        struct_copy.from_numpy(pt, {"iso_strain_step": np.zeros(pt.shape)})
         self.explicit = False
         if self.handbacks == 0:
             self.at_s = t
@@ -128,7 +132,8 @@ class Handover:
         every = math.lcm(self.view.cfg.heat_every, self.view.cfg.geom_every)
         st.scalars.step[None] = -(-int(st.scalars.step[None]) // every) * every
         st.scalars.dt[None] = self.dt
-        st.points.iso_strain_step.fill(0.0)  # the last implicit step's sum, already applied
+        # the last implicit step's sum, already applied
+        struct_copy.from_numpy(st.points, {"iso_strain_step": np.zeros(st.points.shape)})
         self.explicit = True
         self.handbacks += 1
         self.restart_stretch(t)
@@ -145,5 +150,5 @@ class Handover:
         """A stretch of explicit steps begins at t; after a hand-back its starting points are
         kept for its check (before the first hand-over the kinetic rule needs none)."""
         if self.handbacks:
-            copy_points(self.adaptive.st.points, self.adaptive.before)
+            self.adaptive.save()
         self.stretch, self.stretch_s = 0, t

@@ -42,6 +42,7 @@ from ..physics.constitutive import trial_stress
 from ..physics.grid import active, ramped_gamma
 from ..physics.mechanics import apply_walls, interpolate_velocity
 from ..physics.shape import STENCIL_SHAPE, node_weight
+from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.stiffness import (
     WIDTH,
     capillary_tangent,
@@ -53,16 +54,15 @@ from . import checkpoint, struct_copy
 from .fields import State
 from .guard import SimulationError
 from .implicit_heat import StepHeat
-from .implicit_system import GridSystem, dof_index, gather, gather_force
+from .implicit_system import GridSystem, Part, dof_index, gather
 from .linear_solve import LinearSolveError, LinearSolver, linear_solver
-from .loops import check_block, grow_box, in_order, point_loop
+from .loops import check_block, grow_box, in_order, point_loop, point_stencil
 from .step import (
     advance_clock,
     clear_grid,
     g2p_point_mechanics,
     init_box,
     p2g,
-    point_stencil,
     surface_force,
     watch,
 )
@@ -116,7 +116,7 @@ def _begin(st: ti.template()):
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
         m = nd.mass[I]
-        vn = ti.Vector.zero(float, st.cfg.dim)
+        vn = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         free = ti.Vector.zero(ti.i32, st.cfg.dim)
         if m > st.cfg.mass_cut:
             vn = nd.momentum[I] / m
@@ -176,8 +176,8 @@ def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         if st.implicit.with_tangent[None]:
             _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
-        st.implicit.internal[I] = ti.Vector.zero(float, st.cfg.dim)
-        nd.v[I] = ti.Vector.zero(float, st.cfg.dim)
+        st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
+        nd.v[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
     for k in range(v.shape[0]):
         nd.v[dof_index(st, dof_node, k)][dof_node[k, st.cfg.dim]] = v[k]
     point_loop(st, _force_body, False, False, True)
@@ -260,18 +260,18 @@ class ImplicitStepper:
         st = self.st
         self.heat.advance()
         begin(st)
-        free = st.implicit.free.to_numpy()
+        free = struct_copy.to_numpy(st.implicit.numbering, ("free",))["free"]
         flat = free.reshape(-1) != 0
         dof = np.full(flat.shape, -1, dtype=np.int32)
         n = int(flat.sum())
         dof[flat] = np.arange(n, dtype=np.int32)
-        st.implicit.dof.from_numpy(dof.reshape(free.shape))
+        struct_copy.from_numpy(st.implicit.numbering, {"dof": dof.reshape(free.shape)})
         dof_node = np.ascontiguousarray(np.argwhere(free != 0).astype(np.int32))
         cols = np.empty((n, self._slots), dtype=np.int32)
         fixed = np.empty((n, self._slots))
         rhs, v0 = np.empty(n), np.empty(n)
         if n:
-            gather(st, st.implicit.fixed, dof_node, cols, fixed, rhs, v0, True)
+            gather(st, dof_node, cols, fixed, rhs, v0, Part.FIXED)
         slots = cols >= 0
         indptr = np.concatenate([[0], np.cumsum(slots.sum(axis=1))])
         return GridSystem(dof_node, slots, cols[slots], indptr, fixed[slots], rhs, v0)
@@ -285,12 +285,12 @@ class ImplicitStepper:
         st.implicit.with_tangent[None] = int(tangent)
         internal_force(st, v, sys_.dof_node)
         f_int = np.empty(sys_.n)
+        cols = np.empty((1, 1), dtype=np.int32)  # not written
         if not tangent:
-            gather_force(st, sys_.dof_node, f_int)
+            gather(st, sys_.dof_node, cols, np.empty((1, 1)), f_int, f_int, Part.FORCE)
             return f_int, None
         vals = np.empty((sys_.n, self._slots))
-        unused = np.empty((1, 1), dtype=np.int32)
-        gather(st, st.implicit.tangent, sys_.dof_node, unused, vals, f_int, f_int, False)
+        gather(st, sys_.dof_node, cols, vals, f_int, f_int, Part.TANGENT)
         return f_int, vals[sys_.slots]
 
     @staticmethod

@@ -31,10 +31,11 @@ from ..physics.codes import HeatNode
 from ..physics.grid import active
 from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
 from ..physics.thermal import fixed_temperature, point_conductivity
+from . import struct_copy
 from .fields import State
 from .implicit_system import row_neighbour
 from .linear_solve import LinearSolver, linear_solver
-from .loops import in_order, point_loop
+from .loops import in_order, point_loop, point_stencil
 from .step import (
     clear_grid,
     g2p_point_heat,
@@ -42,7 +43,6 @@ from .step import (
     grid_update,
     heat_flux,
     p2g,
-    point_stencil,
 )
 from .time_step import substeps_within
 
@@ -114,18 +114,21 @@ def _neighbour_unknown(st: ti.template(), I, r):
 
 
 @ti.kernel
-def gather_rows(
+def rows_or_flow(
     st: ti.template(),
     nodes: ti.types.ndarray(),
     cols: ti.types.ndarray(),
     vals: ti.types.ndarray(),
-    rhs: ti.types.ndarray(),
+    vec: ti.types.ndarray(),
+    gather: ti.i32,
 ):
-    """Row k of C / dt + K_ff for the free node ``nodes[k]``: its slots' columns (-1: none) and
-    values, and Q^n into rhs."""
+    """``gather``: row k of C / dt + K_ff for the free node ``nodes[k]``, its slots' columns
+    (-1: none) and values, and Q^n into vec. Else, with the solution dT in vec: Q_i -= (K dT)_i
+    at every node with a heat capacity, the fixed ones too (their heat out). One kernel for
+    both (a kernel's compilation costs tens of ms whatever its size)."""
     nd = ti.static(st.nodes)
     dt = st.scalars.dt_heat[None]
-    for k in range(nodes.shape[0]):
+    for k in range(nodes.shape[0] * gather):
         I = ti.Vector([nodes[k, a] for a in ti.static(range(st.cfg.dim))])
         for r in range(WIDTH**st.cfg.dim):
             o, c = _neighbour_unknown(st, I, r)
@@ -136,19 +139,14 @@ def gather_rows(
                     value += nd.heat_capacity[I] / dt
             vals[k, r] = value
             cols[k, r] = c
-        rhs[k] = nd.heat_rate[I]
-
-
-@ti.kernel
-def conduct(st: ti.template(), dT: ti.types.ndarray()):
-    """Q_i -= (K dT)_i at every node with a heat capacity, the fixed ones too (their heat out)."""
+        vec[k] = nd.heat_rate[I]
     for I in ti.grouped(st.implicit.heat_node):
-        if st.implicit.heat_node[I] != HeatNode.EMPTY:
+        if not gather and st.implicit.heat_node[I] != HeatNode.EMPTY:
             flow = 0.0
             for r in range(WIDTH**st.cfg.dim):
                 o, c = _neighbour_unknown(st, I, r)
                 if c >= 0:
-                    flow += st.implicit.conductance[I, o] * dT[c]
+                    flow += st.implicit.conductance[I, o] * vec[c]
             st.nodes.heat_rate[I] -= flow
 
 
@@ -189,18 +187,18 @@ class StepHeat:
     def _backward_euler(self) -> None:
         st = self.st
         in_order(st, rates_and_conductance)
-        kind = st.implicit.heat_node.to_numpy()
+        kind = struct_copy.to_numpy(st.implicit.numbering, ("heat_node",))["heat_node"]
         free = kind == HeatNode.FREE
         unknown = np.full(kind.shape, -1, dtype=np.int32)
         n = int(free.sum())
         unknown[free] = np.arange(n, dtype=np.int32)
-        st.implicit.heat_dof.from_numpy(unknown)
+        struct_copy.from_numpy(st.implicit.numbering, {"heat_dof": unknown})
         if n:
             nodes = np.ascontiguousarray(np.argwhere(free).astype(np.int32))
             slots = WIDTH**st.cfg.dim
             cols = np.empty((n, slots), dtype=np.int32)
             vals, rhs = np.empty((n, slots)), np.empty(n)
-            gather_rows(st, nodes, cols, vals, rhs)
+            rows_or_flow(st, nodes, cols, vals, rhs, True)
             stored = cols >= 0  # columns ascend: unknowns and slots both run in index order
             A = sp.csr_matrix(
                 (vals[stored], cols[stored], np.concatenate([[0], np.cumsum(stored.sum(1))])),
@@ -210,5 +208,6 @@ class StepHeat:
             how = linear_solver(self.case, n)
             if self.linear is None or self.linear.how != how:
                 self.linear = LinearSolver(how, HEAT_RTOL)
-            conduct(st, self.linear.solve(A, rhs))
+            dT = self.linear.solve(A, rhs)
+            rows_or_flow(st, nodes, cols, vals, np.ascontiguousarray(dT, dtype=np.float64), False)
         in_order(st, finish)

@@ -3,6 +3,7 @@ velocity components that are free, numbered node by node in index order, and the
 matrix gathered from the WIDTH^dim node rows the kernels scatter into (physics/stiffness.py),
 laid out as a CSR matrix."""
 
+import enum
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -31,45 +32,52 @@ def dof_index(st: ti.template(), dof_node: ti.template(), k):
     return ti.Vector([dof_node[k, a] for a in ti.static(range(st.cfg.dim))])
 
 
-@ti.kernel
-def gather_force(st: ti.template(), dof_node: ti.types.ndarray(), vec: ti.types.ndarray()):
-    """The internal force at the unknowns."""
-    for k in range(vec.shape[0]):
-        vec[k] = st.implicit.internal[dof_index(st, dof_node, k)][dof_node[k, st.cfg.dim]]
+class Part(enum.IntEnum):
+    """What :func:`gather` reads: the fixed matrix with its columns, the right-hand side and
+    the first iterate; the points' tangent and the internal force; the internal force alone."""
+
+    FIXED = 0
+    TANGENT = 1
+    FORCE = 2
 
 
 @ti.kernel
 def gather(
     st: ti.template(),
-    K: ti.template(),
     dof_node: ti.types.ndarray(),
     cols: ti.types.ndarray(),
     vals: ti.types.ndarray(),
     vec: ti.types.ndarray(),
     guess: ti.types.ndarray(),
-    fixed: ti.template(),
+    part: ti.i32,
 ):
-    """Row k of matrix K (the WIDTH^dim x dim slots of node-component k; cols -1 where the
-    neighbour's component is not an unknown) and, ``fixed``: the columns, the right-hand side
-    m v^n / dt + f into vec and v^n into guess; else: the internal force into vec."""
+    """Row k of the fixed matrix or of the tangent (the WIDTH^dim x dim slots of node-component
+    k; cols -1 where the neighbour's component is not an unknown) and a vector, as ``part``
+    (:class:`Part`) says: FIXED the columns, the right-hand side m v^n / dt + f into vec and v^n
+    into guess; TANGENT and FORCE the internal force into vec. One kernel for the three (a
+    template per part would compile three)."""
     nd = ti.static(st.nodes)
-    for k in range(vals.shape[0]):
+    for k in range(vec.shape[0]):
         I = dof_index(st, dof_node, k)
         a = dof_node[k, st.cfg.dim]
-        for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
-            o, J, inside = row_neighbour(st.implicit.dof, I, r)
-            for b in ti.static(range(st.cfg.dim)):
-                slot = r * st.cfg.dim + b
-                c = -1
-                if inside:
-                    c = st.implicit.dof[J][b]
-                value = 0.0
-                if c >= 0:
-                    value = K[I, o, a, b]
-                vals[k, slot] = value
-                if ti.static(fixed):
-                    cols[k, slot] = c
-        if ti.static(fixed):
+        if part != Part.FORCE:
+            for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
+                o, J, inside = row_neighbour(st.implicit.dof, I, r)
+                for b in ti.static(range(st.cfg.dim)):
+                    slot = r * st.cfg.dim + b
+                    c = -1
+                    if inside:
+                        c = st.implicit.dof[J][b]
+                    value = 0.0
+                    if c >= 0:
+                        if part == Part.FIXED:
+                            value = st.implicit.fixed[I, o, a, b]
+                        else:
+                            value = st.implicit.tangent[I, o, a, b]
+                    vals[k, slot] = value
+                    if part == Part.FIXED:
+                        cols[k, slot] = c
+        if part == Part.FIXED:
             vec[k] = nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]
             guess[k] = nd.v[I][a]
         else:

@@ -8,6 +8,7 @@ the point's block (0 outside the blocks layout)."""
 from taichi_sls.backend import ti
 
 from ..physics.grid import active
+from ..physics.shape import stencil, stencil_base
 from ..physics.thermal import wall_heat
 from .blocks import MARGIN, SIDE
 from .step_config import Layout
@@ -41,6 +42,24 @@ def point_loop(
     else:
         for p in range(st.cfg.n_points):
             body(st, p, 0, heat, geom)
+
+
+@ti.func
+def point_stencil(cfg: ti.template(), pt: ti.template(), p):
+    base, w, dw = stencil(pt.x[p], cfg.inv_h, cfg.h, cfg.lp, cfg.off)
+    return _clamped(cfg, base), w, dw
+
+
+@ti.func
+def point_base(cfg: ti.template(), pt: ti.template(), p):  # point_stencil's base alone
+    return _clamped(cfg, stencil_base(pt.x[p], cfg.inv_h, cfg.off))
+
+
+@ti.func
+def _clamped(cfg: ti.template(), base):
+    # A point that has left the grid (or become NaN) must not write outside the arrays: the
+    # guard reports it at the next frame; the 2-cell padding keeps a healthy run far from this.
+    return ti.max(ti.min(base, ti.Vector([cfg.nx - 4, cfg.ny - 4])), 1)
 
 
 @ti.func

@@ -5,7 +5,7 @@ import numpy as np
 
 from . import struct_copy
 from .contacts import neck_width, pair_reach, point_colour
-from .grid_views import colour_only, level_set_only
+from .grid_views import interface_fields
 from .monitor import neck_measures
 
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
@@ -18,9 +18,10 @@ class NeckMeasures:
     """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass`` and
     ``_body_radius`` (set by :class:`Simulation`)."""
 
-    def point_arrays(self) -> dict[str, np.ndarray]:
-        """The points' members the host reads (HOST_POINT_MEMBERS), copied by one kernel."""
-        return struct_copy.to_numpy(self.state.points, HOST_POINT_MEMBERS)
+    def point_arrays(self, keys: tuple[str, ...] = HOST_POINT_MEMBERS) -> dict[str, np.ndarray]:
+        """The points' members the host reads (default HOST_POINT_MEMBERS), copied by the one
+        kernel that copies any of them."""
+        return struct_copy.to_numpy(self.state.points, keys)
 
     def node_arrays(self) -> dict[str, np.ndarray]:
         """The node fields the neck measures read (HOST_NODE_MEMBERS), copied by one kernel."""
@@ -28,13 +29,13 @@ class NeckMeasures:
 
     def phi(self) -> np.ndarray:
         """Level set of eq. 21 on the nodes (m) of the current points."""
-        level_set_only(self.state)
+        interface_fields(self.state)
         return self.node_arrays()["phi"]
 
     def colour(self) -> np.ndarray:
         """The surface-energy colour c_i of the current points on the nodes (the contoured
         one: filtered when the case filters it)."""
-        colour_only(self.state)
+        interface_fields(self.state)
         return self.node_arrays()["colour"]
 
     def neck_measure(self) -> str:

@@ -52,7 +52,7 @@ def init_taichi(
     seconds instead of about 100 s and runs about 1.1-1.5x slower. ``fast_math=False``: strict
     IEEE arithmetic (the compiler may not reorder sums), so that a change of code structure that
     keeps every formula keeps every result bit for bit."""
-    front_end.install()
+    front_end.install(ti)
     ti.init(
         arch=ti.cpu if arch == "cpu" else ti.gpu,
         default_fp=ti.f64 if precision == "f64" else ti.f32,
@@ -213,7 +213,7 @@ class Simulation(NeckMeasures):
         an explicit heat step's strain increment may be under way)."""
         self.state.scalars.t[None] = 0.0
         self.steps = 0
-        self.state.points.x0.copy_from(self.state.points.x)
+        struct_copy.from_numpy(self.state.points, {"x0": self.point_arrays(("x",))["x"]})
         if self.adaptive is not None:
             self.adaptive.dt = self.adaptive.first_dt
         if self.handover is not None:

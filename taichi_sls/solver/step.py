@@ -41,7 +41,7 @@ from ..physics.mechanics import (
     p2g_mechanics,
     p2g_momentum,
 )
-from ..physics.shape import stencil
+from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
     g2p_heat,
@@ -58,19 +58,10 @@ from .loops import (
     grow_box,
     peak_temperature,
     point_loop,
+    point_stencil,
     reduce_blocks,
     wall_heat_in_order,
 )
-
-
-@ti.func
-def point_stencil(cfg: ti.template(), pt: ti.template(), p):
-    base, w, dw = stencil(pt.x[p], cfg.inv_h, cfg.h, cfg.lp, cfg.off)
-    # A point that has left the grid (or become NaN) must not write outside the arrays: clamp
-    # its stencil; the guard reports it at the next frame. The 2-cell padding keeps every point
-    # of a healthy run far from this bound.
-    base = ti.max(ti.min(base, ti.Vector([cfg.nx - 4, cfg.ny - 4])), 1)
-    return base, w, dw
 
 
 @ti.func
@@ -95,8 +86,8 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         nd.mass[I] = 0.0
-        nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
-        nd.force[I] = ti.Vector.zero(float, st.cfg.dim)
+        nd.momentum[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
+        nd.force[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         if ti.static(st.cfg.thermal):
             if heat:
                 nd.heat_capacity[I] = 0.0
@@ -337,7 +328,7 @@ def g2p(st: ti.template(), heat: ti.template(), geom: ti.template()):
     point_loop(st, _g2p_body, heat, geom, False)
     if ti.static(_musl(st) and st.cfg.mech):
         for I in ti.grouped(ti.ndrange(*active(st.box))):
-            nd.momentum[I] = ti.Vector.zero(float, st.cfg.dim)
+            nd.momentum[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         point_loop(st, _momentum_body, heat, geom, True)
         for I in ti.grouped(ti.ndrange(*active(st.box))):
             grid_remap_velocity(st.cfg, nd, I)

@@ -222,10 +222,8 @@ def test_a_pairs_contact_region_is_the_pair_verdicts_neck_region():
         scene=sc,
         body_radii_m=np.sqrt(area / np.pi),
         body_centres_m=lambda initial: centres,
-        state=SimpleNamespace(
-            points=SimpleNamespace(x0=SimpleNamespace(to_numpy=lambda: sc.x)),
-            cfg=SimpleNamespace(h=case.grid.spacing_um * 1e-6),
-        ),
+        point_arrays=lambda keys: {"x0": sc.x},
+        state=SimpleNamespace(cfg=SimpleNamespace(h=case.grid.spacing_um * 1e-6)),
     )
     points, normals = contact_geometry(sim)
     assert points[0] == pytest.approx(0.5 * (centres[0] + centres[1]))

@@ -17,11 +17,11 @@ from taichi_sls.solver.adaptive import (
     GROWTH,
     SAFETY,
     SHRINK,
+    PointsPass,
     StepControls,
     copy_points,
     laser_switch_times,
     next_step,
-    step_changes,
 )
 from taichi_sls.solver.fields import POINT_MEMBERS, struct_type
 from taichi_sls.solver.guard import SimulationError
@@ -69,7 +69,7 @@ def test_step_changes_measure_temperature_and_strain():
     e = 0.01 * rng.normal(size=(2, 2))
     F = np.repeat(F0[None], n, axis=0)
     T = np.full(n, 400.0)
-    copy_points(sim.state.points, sim.adaptive.before)
+    sim.adaptive.save()
     sim.adaptive.before.F.from_numpy(F)
     sim.adaptive.before.T.from_numpy(T)
     F[7] = (np.eye(2) + e) @ F0
@@ -81,7 +81,7 @@ def test_step_changes_measure_temperature_and_strain():
     sim.state.points.T.from_numpy(T)
     sim.state.points.equivalent_plastic_strain.from_numpy(plastic)
     sim.state.points.v.fill(0.0)
-    step_changes(sim.state.points, sim.adaptive.before, sim.adaptive.changes, 1e-6)
+    sim.adaptive.points_pass(PointsPass.CHANGES, 1e-6)
     dT, de, dx, dp = sim.adaptive.changes[None]
     assert dT == pytest.approx(2.5)
     assert de == pytest.approx(np.linalg.norm(e), rel=1e-10)
@@ -127,10 +127,10 @@ def test_a_redone_step_starts_from_the_state_before_it():
     sim.advance(2)
     before, dt_next = checkpoint.capture(sim.state, points=False), sim.adaptive.dt
     kept = struct_type(POINT_MEMBERS, 2).field(shape=sim.state.n_points)
-    copy_points(sim.state.points, kept)
+    copy_points(sim.state.points, kept, True)
     sim.advance(3)
     first = sim.state.points.to_numpy()
-    copy_points(kept, sim.state.points)
+    copy_points(sim.state.points, kept, False)
     checkpoint.restore(sim.state, before)
     sim.adaptive.dt = dt_next
     sim.advance(3)

@@ -74,8 +74,8 @@ def test_a_point_whose_two_solutions_disagree_keeps_the_halves():
     time_ = {"integrator": "implicit", "implicit_scheme": "extrapolated"}
     sim = Simulation(ver.load("laplace", 10, {"time": time_}).case)
     stepper, pt = sim.implicit, sim.state.points
-    copy_points(pt, stepper.whole)
-    copy_points(pt, stepper.start)
+    copy_points(pt, stepper.whole, True)
+    copy_points(pt, stepper.start, True)
     J = pt.J.to_numpy()
     whole = J.copy()
     whole[0] *= 3.0  # extrapolated: -J, refused
