@@ -123,7 +123,10 @@ def neck_width(
     n = np.array([-e[1], e[0]])
     step = SECTION_STEP * h
     s = np.arange((0.5 - SECTION_RANGE) * d, (0.5 + SECTION_RANGE) * d + 0.5 * step, step)
-    t = np.arange(-reach, reach + 0.5 * step, step)
+    # whole steps either side of the line of centres: the same samples whatever the reach, so a
+    # longer reach reads a section inside the shorter one's span as that one did
+    n_t = math.ceil(reach / step - 1e-9)
+    t = step * np.arange(-n_t, n_t + 1)
     xy = ca[None, None, :] + s[:, None, None] * e + t[None, :, None] * n  # (S, T, 2)
     c = bilinear(material, h, off, xy[..., 0], xy[..., 1], outside=-1.0)
     widths = np.array([_outer_span(row, t) for row in c])

@@ -86,17 +86,23 @@ class NeckMeasures:
     def necks_m(self, measure: str | None = None) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``: the narrowest section
         across the line of the two bodies' mass centres, between the outermost crossings of the
-        interface (:func:`taichi_sls.solver.contacts.neck_width`)."""
+        interface (:func:`taichi_sls.solver.contacts.neck_width`), out to the pair's reach."""
         if not self.contacts:
             return []
         field = self._material_field(measure or self.neck_measure(), "centres")
-        centre = self.body_centres_m()
-        cfg = self.state.cfg
-        out = []
-        for a, b in self.contacts:
-            reach = min(self._body_radius[a], self._body_radius[b])
-            out.append(neck_width(field, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
-        return out
+        return self._contact_necks(lambda a, b: field)
+
+    def _contact_necks(self, field_of) -> list[float]:
+        """neck_width of every contact on ``field_of(a, b)``, sampled out to
+        :func:`~taichi_sls.solver.contacts.pair_reach`: the coalesced end state of the pair,
+        so a neck is followed past the bodies' initial diameter (issue #40 item 6)."""
+        centre, r, cfg = self.body_centres_m(), self._body_radius, self.state.cfg
+        return [
+            neck_width(
+                field_of(a, b), cfg.h, cfg.off, centre[a], centre[b], pair_reach(r[a], r[b])
+            )[0]
+            for a, b in self.contacts
+        ]
 
     @property
     def body_radii_m(self) -> np.ndarray:
@@ -134,13 +140,10 @@ class NeckMeasures:
         order = np.argsort(body, kind="stable")
         bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
         members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
-        centre = self.body_centres_m()
         shape = (cfg.nx, cfg.ny)
-        out = []
-        for a, b in self.contacts:
+
+        def colour(a: int, b: int) -> np.ndarray:
             sel = np.concatenate([members[a], members[b]])
-            c = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
-            # the pair's own colour holds no neighbours: reach out to the coalesced end state
-            reach = pair_reach(self._body_radius[a], self._body_radius[b])
-            out.append(neck_width(c, cfg.h, cfg.off, centre[a], centre[b], reach)[0])
-        return out
+            return point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
+
+        return self._contact_necks(colour)

@@ -216,8 +216,20 @@ def test_hopper_from_touching_discs_R0_h_10():
 @pytest.mark.slow
 def test_hopper_from_touching_discs_R0_h_20():
     """The issue's target: within 5 % at R0/h = 20, area within 0.5 % (measured -3.1 / -2.1 /
-    -0.4 / -0.1 % with the mid-plane on a node line, -0.07 % area; 3.5 min)."""
+    -0.4 / -0.1 % with the mid-plane on a node line, -0.07 % area; 3.5 min, 12 min on two
+    shared cores).
+
+    The same run read by the per-contact section the process results rest on
+    (``Simulation.necks_m``, reach ``pair_reach``; issue #40 item 6): within 3 % (that item's
+    bar) at tau = 2 and 3, where the exact neck is past the discs' initial diameter (measured
+    -0.36 / +0.40 %; the old reach, the smaller radius, read -12.1 / -21.8 % on the same
+    states). Not asserted at tau = 0.5 and 1 (measured -13.5 / -4.7 %): that section reads the
+    raw colour, which keeps the one-cell notch along the node-line mid-plane that the force's
+    filter closes, and the section lying along it reads the notch (on the filtered colour the
+    same sections read -3.0 / -2.2 %; docs/verification.md)."""
     r = ver.run(ver.load("hopper", 20))
     for k in ("neck_tau0.5", "neck_tau1", "neck_tau2", "neck_tau3"):
         assert abs(r.errors[k]) < 0.05, r.errors
     assert abs(r.errors["area"]) < 0.005
+    for k in ("neck_centres_tau2", "neck_centres_tau3"):
+        assert abs(r.errors[k]) < 0.03, r.errors
