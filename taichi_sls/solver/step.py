@@ -33,6 +33,7 @@ from ..physics.constitutive import stress_update, thermal_strain_increment, ther
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
 from ..physics.level_set import scatter_level_set
+from ..physics.materials import KINETICS_MOLTEN
 from ..physics.mechanics import (
     g2p_kinematics,
     g2p_velocity,
@@ -255,11 +256,19 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             chi = st.cfg.subgrid_filter
             if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
                 chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
-            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi)
+            dt_heat = 0.0
+            if ti.static(st.cfg.kinetics):
+                dt_heat = heat_step(st)
+            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
             if ti.static(st.cfg.any_fixed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
-            if pt.solid_fraction[p] == 0.0:  # above T_m for this heat step
+            molten = pt.solid_fraction[p] == 0.0  # above T_m for this heat step
+            if ti.static(st.cfg.kinetics):  # or a melt under 1 % crystallised
+                molten = molten or (
+                    mat[pt.material[p]].kinetics != 0 and pt.solid_fraction[p] < KINETICS_MOLTEN
+                )
+            if molten:
                 if ti.static(st.cfg.implicit):
                     pt.time_molten[p] += st.scalars.dt_heat[None]
                 else:
