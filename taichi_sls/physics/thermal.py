@@ -49,6 +49,7 @@ from taichi_sls.backend import ti
 from .grid import scatter_add
 from .laser import laser_source
 from .materials import (
+    KINETICS_MOLTEN,
     apparent_heat_capacity,
     crystallize_at_enthalpy,
     enthalpy,
@@ -74,6 +75,17 @@ def point_heat_capacity(cfg: ti.template(), mp: ti.template(), T, xi):
     else:
         c = apparent_heat_capacity(mp, T)
     return c
+
+
+@ti.func
+def counts_molten(cfg: ti.template(), mp: ti.template(), xi):
+    """Whether a point counts as molten this heat step (``time_molten``): xi_s = 0 (above T_m,
+    or a supercooled melt); with kinetics also a kinetics material's melt under
+    KINETICS_MOLTEN crystallised, whose xi_s leaves 0 as soon as it cools below T_m0."""
+    molten = xi == 0.0
+    if ti.static(cfg.kinetics):
+        molten = molten or (mp.kinetics != 0 and xi < KINETICS_MOLTEN)
+    return molten
 
 
 @ti.func

@@ -33,7 +33,6 @@ from ..physics.constitutive import stress_update, thermal_strain_increment, ther
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
 from ..physics.level_set import scatter_level_set
-from ..physics.materials import KINETICS_MOLTEN
 from ..physics.mechanics import (
     g2p_kinematics,
     g2p_velocity,
@@ -45,6 +44,7 @@ from ..physics.mechanics import (
 from ..physics.shape import stencil
 from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
+    counts_molten,
     g2p_heat,
     grid_heat,
     grid_temperature,
@@ -256,23 +256,13 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             chi = st.cfg.subgrid_filter
             if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
                 chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
-            dt_heat = 0.0
-            if ti.static(st.cfg.kinetics):
-                dt_heat = heat_step(st)
+            dt_heat = heat_step(st)  # = dt heat_every explicit; dt_heat[None] implicit
             dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
             if ti.static(st.cfg.any_fixed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
-            molten = pt.solid_fraction[p] == 0.0  # above T_m for this heat step
-            if ti.static(st.cfg.kinetics):  # or a melt under 1 % crystallised
-                molten = molten or (
-                    mat[pt.material[p]].kinetics != 0 and pt.solid_fraction[p] < KINETICS_MOLTEN
-                )
-            if molten:
-                if ti.static(st.cfg.implicit):
-                    pt.time_molten[p] += st.scalars.dt_heat[None]
-                else:
-                    pt.time_molten[p] += dt * st.cfg.heat_every
+            if counts_molten(st.cfg, mat[pt.material[p]], pt.solid_fraction[p]):
+                pt.time_molten[p] += dt_heat
             if ti.static(st.cfg.th_strain and st.cfg.mech):
                 if ti.static(st.cfg.implicit):  # the step's strain: the sum over its substeps
                     inc = thermal_strain_increment(pt, mat, p, dT, dxi)
