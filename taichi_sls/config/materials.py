@@ -18,6 +18,27 @@ def _poisson(v: float) -> float:
 Poisson = Annotated[float, AfterValidator(_poisson)]
 
 
+class CrystallizationKinetics(Model):
+    """Quiescent crystallisation kinetics (docs/model.md): Nakamura's non-isothermal form of the
+    isothermal Avrami law with a Hoffman-Lauritzen half time. Defaults: the PA12 values of
+    docs/pa12_process.md (``studies.references.crystallization.PA12_CRYSTALLIZATION``), of which
+    n, T_m0_C and K_g_K2 are modelling choices and inv_t_half_0_1_s is calibrated to a 146 C DSC
+    peak at 10 K/min."""
+
+    n: float = Field(3.0, ge=1.0, le=4.0, description="Avrami exponent n, in [1, 4]")
+    inv_t_half_0_1_s: float = Field(
+        9.072e4, gt=0, description="(1/t_1/2)_0, the pre-factor of the half-time law (1/s)"
+    )
+    U_J_mol: float = Field(
+        6270.0, gt=0, description="U, activation energy of segmental transport (J/mol)"
+    )
+    T_inf_C: float = Field(13.0, description="T_inf, where transport stops: T_g - 30 K (C)")
+    T_m0_C: float = Field(
+        200.0, description="T_m0 (> T_inf_C), the equilibrium melting temperature (C)"
+    )
+    K_g_K2: float = Field(2.0e5, gt=0, description="K_g, the nucleation constant (K^2)")
+
+
 class Material(Model):
     """Every parameter of the paper's Table 3. `_solid` holds for T <= T_c, `_liquid` for
     T >= T_m; in between they are interpolated linearly in the solid fraction (eq. 33)."""
@@ -32,7 +53,7 @@ class Material(Model):
     crystallization_C: float = Field(
         146.0,
         description="T_c (< T_m): the melting range is [T_c, T_m], on heating and cooling alike "
-        "(eq. 33); with crystallization_range_C set, on heating only",
+        "(eq. 33); with crystallization_range_C or crystallization_kinetics set, on heating only",
     )
     crystallization_range_C: Pair | None = Field(
         None,
@@ -43,6 +64,18 @@ class Material(Model):
         "absorbed on melting and released on crystallisation (docs/model.md). PA12 melts at "
         "about 175-185 C and crystallises near 145-150 C. Unset: the paper's one range [T_c, "
         "T_m] both ways",
+    )
+    crystallization_kinetics: CrystallizationKinetics | None = Field(
+        None,
+        description="crystallisation from kinetics instead of a range (docs/model.md), e.g. "
+        "[materials.PA12.crystallization_kinetics] with no keys for the PA12 defaults; not with "
+        "crystallization_range_C. Each point's solid fraction is history as with the range: it "
+        "melts over [T_c, T_m] on heating, and a melt crystallises by Nakamura's law, "
+        "X = 1 - exp(-(int K_N(T) dt)^n), K_N = (ln 2)^(1/n) / t_1/2(T), at any temperature in "
+        "(T_inf, T_m0) where its melting branch allows it; the latent heat is released as it "
+        "does. How long a melt lives at a bed temperature then follows from the material "
+        "(PA12 defaults at 170 C: 1 % crystallised after 31 min). Unset: the paper's one range, "
+        "or crystallization_range_C",
     )
     expansion_solid_1_K: float = Field(15e-5, description="alpha for T <= T_c")
     expansion_liquid_1_K: float = Field(5e-5, description="alpha for T >= T_m")
@@ -87,6 +120,7 @@ class Material(Model):
 
     def solid_below_C(self) -> float:
         """The temperature below which the material is solid whatever its history (C): the
-        bottom of the crystallisation range, or T_c without hysteresis."""
+        bottom of the crystallisation range, or T_c without hysteresis. With kinetics no
+        temperature is (a melt may live for ever above T_inf): T_c, a progress estimate only."""
         r = self.crystallization_range_C
         return self.crystallization_C if r is None else r[0]

@@ -42,7 +42,8 @@ class Time(Model):
     stop: Literal["end", "solidified"] = Field(
         "end",
         description="end: run to end_s; solidified: once every laser is off, run until every "
-        "point is solid (T <= T_c; with crystallization_range_C, crystallised) and the kinetic "
+        "point is solid (T <= T_c; with crystallization_range_C or crystallization_kinetics, "
+        "crystallised) and the kinetic "
         "energy has fallen below settled_kinetic_fraction of the surface energy, or to max_s "
         "(then marked max_time)",
     )

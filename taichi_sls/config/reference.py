@@ -10,7 +10,7 @@ from pydantic_core import PydanticUndefined
 
 from .bed import Bed
 from .bodies import Disc, LayerBody, Polygon, Rect
-from .materials import Material
+from .materials import CrystallizationKinetics, Material
 from .schema import Case
 from .sections import Boundary, Wall
 
@@ -28,6 +28,7 @@ def sections() -> list[tuple[str, type[BaseModel]]]:
             out.append(("bed", Bed))
         elif name == "materials":
             out.append(("materials.NAME", Material))
+            out.append(("materials.NAME.crystallization_kinetics", CrystallizationKinetics))
         elif name == "boundary":
             out.append(("boundary.left / right / bottom / top", Wall))
         elif name == "lasers":
@@ -56,7 +57,7 @@ def describe_keys() -> str:
     for title, cls in sections():
         out += [f"## `{title}`", ""]
         doc = cls.__doc__ or ""
-        if cls is Material:
+        if cls in (Material, CrystallizationKinetics):
             out += [" ".join(doc.split()), ""]
         out += ["| key | default | meaning |", "|---|---|---|"]
         fields = sorted(cls.model_fields.items(), key=lambda kv: kv[0] != "shape")

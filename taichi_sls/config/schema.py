@@ -197,6 +197,17 @@ class Case(Model):
                     f"melt_C = {m.melt_C}"
                 )
             rng = m.crystallization_range_C
+            kin = m.crystallization_kinetics
+            if kin is not None and rng is not None:
+                raise CaseError(
+                    f"materials.{name}.crystallization_kinetics: set with "
+                    f"crystallization_range_C = {rng}; choose one (kinetics or a range)"
+                )
+            if kin is not None and not kin.T_inf_C < kin.T_m0_C:
+                raise CaseError(
+                    f"materials.{name}.crystallization_kinetics.T_inf_C = {kin.T_inf_C}: must "
+                    f"be below T_m0_C = {kin.T_m0_C}"
+                )
             if rng is not None and not rng[0] < rng[1] <= m.crystallization_C:
                 raise CaseError(
                     f"materials.{name}.crystallization_range_C = {rng}: must be [T_low, T_high] "

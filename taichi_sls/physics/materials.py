@@ -23,6 +23,11 @@ keeps the enthalpy above, bit for bit. (S's capacity follows the melting branch,
 a supercooled melt takes the solid's c; exact for Table 3's c_c = c_m.) For a given previous
 xi_s, H(T, update(T, xi_s)) rises monotonically in T (crystallisation branch, fraction held,
 melting branch), so the inverse T(H; xi_s) is again closed form and unique.
+
+Crystallisation kinetics (``kinetics`` = 1, docs/model.md eqs. K1-K3): the history above with
+no crystallisation branch (its range set below 0 K, :data:`KINETICS_RANGE_K`); a melt instead
+crystallises by Nakamura's law at its carried enthalpy, the latent heat raising T
+(:func:`crystallize_at_enthalpy`).
 """
 
 from taichi_sls.backend import ti
@@ -66,8 +71,27 @@ MATERIAL_MEMBERS = (
     "hysteresis",
     "crystallization_low_K",
     "crystallization_high_K",
+    # crystallisation kinetics (materials.NAME.crystallization_kinetics): 1 when set (hysteresis
+    # is then 1 too, its range KINETICS_RANGE_K); Nakamura's rate law, temperatures in K
+    "kinetics",
+    "kinetics_n",
+    "kinetics_inv_t_half_0_1_s",
+    "kinetics_U_J_mol",
+    "kinetics_T_inf_K",
+    "kinetics_T_m0_K",
+    "kinetics_K_g_K2",
 )
-INT_MEMBERS = ("viscosity_model", "hysteresis")
+INT_MEMBERS = ("viscosity_model", "hysteresis", "kinetics")
+
+# The crystallisation range (K) of a material with kinetics: below 0 K, so that the range's
+# branch xi_k(T) is 0 at every temperature and the hysteresis functions keep only melting and
+# the held fraction; the kinetics crystallise (:func:`crystallize_at_enthalpy`).
+KINETICS_RANGE_K = (-1.0, 0.0)
+GAS_CONSTANT = 8.314462618  # J/(mol K)
+# With kinetics a point counts as molten (time_molten) while under 1 % crystallised: its
+# fraction leaves 0 as soon as it cools below T_m0 (docs/pa12_process.md: "essentially
+# amorphous", avrami_time_to(0.01))
+KINETICS_MOLTEN = 0.01
 
 
 def material_struct():
@@ -243,3 +267,95 @@ def heat_capacity_history(mp: ti.template(), T, xi):
         if T > T_l and T < T_h and xi <= crystallization_fraction(mp, T) + BRANCH_TOL:
             c += mp.latent_heat_J_kg / (T_h - T_l)
     return c
+
+
+# ----------------------------------------------------------------------------- kinetics
+# Nakamura's integral form (docs/model.md, eqs. K1-K3): X = 1 - exp(-theta^n), theta = int K_N dt.
+# The state is the solid fraction itself: theta = (-ln(1 - xi_s))^(1/n) is recovered from it
+# each heat step, advanced by K_N(T) dt, and mapped back. At constant T this is the Avrami
+# closed form for any step (theta is linear in t); melting lowers xi_s and with it theta.
+
+
+@ti.func
+def nakamura_rate_constant(mp: ti.template(), T):
+    """K_N(T) = (ln 2)^(1/n) / t_1/2(T) (1/s), eq. K3: the Hoffman-Lauritzen half time
+    1/t_1/2 = (1/t_1/2)_0 exp(-U / (R (T - T_inf))) exp(-K_g / (T dT f)), dT = T_m0 - T,
+    f = 2 T / (T + T_m0); 0 outside (T_inf, T_m0)."""
+    T_inf = mp.kinetics_T_inf_K
+    T_m0 = mp.kinetics_T_m0_K
+    K = 0.0
+    if T > T_inf and T < T_m0:
+        f = 2.0 * T / (T + T_m0)
+        log_rate = ti.log(mp.kinetics_inv_t_half_0_1_s) - mp.kinetics_U_J_mol / (
+            GAS_CONSTANT * (T - T_inf)
+        )
+        log_rate -= mp.kinetics_K_g_K2 / (T * (T_m0 - T) * f)
+        K = ti.exp(ti.log(ti.log(2.0)) / mp.kinetics_n + log_rate)
+    return K
+
+
+# below this, 1 - exp(-u) and -ln(1 - x) by their series: the incubation's X of 1e-30 must
+# survive the round trip X -> theta -> X every step (1 - exp(-u) would round it to 0)
+SERIES_BELOW = 1e-2
+
+
+@ti.func
+def _one_minus_exp_neg(u):
+    """1 - exp(-u) for u >= 0 without cancellation (Taylor to u^8 below 1e-2: 1e-19 relative)."""
+    r = 0.0
+    if u < SERIES_BELOW:
+        term = u
+        for k in ti.static(range(2, 9)):
+            r += term
+            term *= -u / k
+        r += term
+    else:
+        r = 1.0 - ti.exp(-u)
+    return r
+
+
+@ti.func
+def _minus_log_one_minus(x):
+    """-ln(1 - x) for 0 <= x < 1 without cancellation (series to x^10 below 1e-2: 1e-21)."""
+    r = 0.0
+    if x < SERIES_BELOW:
+        xk = x
+        for k in ti.static(range(1, 11)):
+            r += xk / k
+            xk *= x
+    else:
+        r = -ti.log(1.0 - x)
+    return r
+
+
+@ti.func
+def nakamura_step(mp: ti.template(), T, xi, dt):
+    """The crystalline fraction after dt at T from xi (eqs. K1-K2): theta = (-ln(1 - xi))^(1/n)
+    + K_N(T) dt, X = 1 - exp(-theta^n); never below xi."""
+    X = xi
+    if xi < 1.0:
+        K = nakamura_rate_constant(mp, T)
+        if K > 0.0:
+            n = mp.kinetics_n
+            theta = ti.pow(_minus_log_one_minus(xi), 1.0 / n) + K * dt
+            X = ti.max(xi, ti.min(1.0, _one_minus_exp_neg(ti.pow(theta, n))))
+    return X
+
+
+@ti.func
+def crystallize_at_enthalpy(mp: ti.template(), H, T, xi, dt):
+    """A kinetics point's (T, xi_s) after its heat step left it at (T, xi) with enthalpy H: the
+    fraction crystallises by :func:`nakamura_step` at T over dt and the latent heat it releases
+    raises T at the same H, T = S^-1(H - l_s (1 - xi_s)) (energy exact: H(T, xi_s) = H). A
+    point that would crystallise past its melting branch (recalescence into [T_c, T_m]) stops
+    on the branch: T = T(H), xi_s = xi_m(T)."""
+    T1 = T
+    xi1 = nakamura_step(mp, T, xi, dt)
+    if xi1 > xi:
+        T1 = _sensible_temperature(mp, H - mp.latent_heat_J_kg * (1.0 - xi1))
+        if xi1 > solid_fraction(mp, T1):
+            T1 = temperature_from_enthalpy(mp, H)
+            xi1 = solid_fraction(mp, T1)
+    else:
+        xi1 = xi
+    return T1, xi1

@@ -27,6 +27,12 @@ T, and c_p is the apparent capacity of the branch the point is on (melting, crys
 none while the fraction holds). The energy balance is untouched: it never depended on c_p.
 Without it (``ti.static``) the code is the one above.
 
+Crystallisation kinetics (``cfg.kinetics``, some material sets ``crystallization_kinetics``;
+hysteresis is then on): after T and xi_s of the heat step, a kinetics point's melt crystallises
+by Nakamura's law over the heat step at that T, at the same enthalpy, so the latent heat it
+releases raises T (physics/materials.py ``crystallize_at_enthalpy``). The carried enthalpy is
+untouched: the energy balance holds as before.
+
 Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
 increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
@@ -43,7 +49,9 @@ from taichi_sls.backend import ti
 from .grid import scatter_add
 from .laser import laser_source
 from .materials import (
+    KINETICS_MOLTEN,
     apparent_heat_capacity,
+    crystallize_at_enthalpy,
     enthalpy,
     enthalpy_history,
     heat_capacity_history,
@@ -68,6 +76,17 @@ def point_heat_capacity(cfg: ti.template(), mp: ti.template(), T, xi):
     else:
         c = apparent_heat_capacity(mp, T)
     return c
+
+
+@ti.func
+def counts_molten(cfg: ti.template(), mp: ti.template(), xi):
+    """Whether a point counts as molten this heat step (``time_molten``): xi_s = 0 (above T_m,
+    or a supercooled melt); with kinetics also a kinetics material's melt under
+    KINETICS_MOLTEN crystallised, whose xi_s leaves 0 as soon as it cools below T_m0."""
+    molten = xi == 0.0
+    if ti.static(cfg.kinetics):
+        molten = molten or (mp.kinetics != 0 and xi < KINETICS_MOLTEN)
+    return molten
 
 
 @ti.func
@@ -207,10 +226,11 @@ def g2p_heat(
     w,
     dw,
     chi,
+    dt_heat,
 ):
     """Enthalpy increment from the grid; returns (dT, d xi_s) for the thermal strains and the
     heat the point exchanged with fixed walls (J/m, counted in heat_out). ``chi``: the sub-grid
-    filter's fraction this heat step.
+    filter's fraction this heat step; ``dt_heat`` the heat step (read with kinetics only).
 
     Points away from fixed-temperature walls take the FLIP increment c_p sum N dT_i (exact energy
     transfer). A point within the support of a fixed node takes the interpolated grid temperature
@@ -263,6 +283,9 @@ def g2p_heat(
     if ti.static(cfg.hysteresis):  # xi_s is history: T from (H, xi0), then xi0 updated at T
         T1 = temperature_from_enthalpy_history(mp, pt.enthalpy[p], xi0)
         xi1 = solid_fraction_history(mp, T1, xi0)
+        if ti.static(cfg.kinetics):  # then the melt crystallises over the heat step
+            if mp.kinetics:
+                T1, xi1 = crystallize_at_enthalpy(mp, pt.enthalpy[p], T1, xi1, dt_heat)
     else:
         T1 = temperature_from_enthalpy(mp, pt.enthalpy[p])
         xi1 = solid_fraction(mp, T1)

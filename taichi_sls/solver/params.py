@@ -10,9 +10,10 @@ import math
 import numpy as np
 
 from ..config import Case, Material
+from ..config.materials import CrystallizationKinetics
 from ..physics.codes import ViscosityModel
 from ..physics.laser import LASER_MEMBERS
-from ..physics.materials import INT_MEMBERS, KELVIN, MATERIAL_MEMBERS
+from ..physics.materials import INT_MEMBERS, KELVIN, KINETICS_RANGE_K, MATERIAL_MEMBERS
 
 # the material keys that are temperatures (C), kept in kelvin under the same name with _K
 TEMPERATURES_C = ("melt_C", "crystallization_C")
@@ -28,11 +29,25 @@ def material_values(m: Material, enthalpy_reference_C: float) -> dict[str, float
             vals[key] = int(ViscosityModel[v.upper()])
         elif key == "crystallization_range_C":
             # hysteresis: the crystallisation range in K and the flag the kernels branch on; a
-            # material without it keeps its melting range both ways (physics/materials.py)
+            # material without it keeps its melting range both ways (physics/materials.py).
+            # Kinetics keep the history (hysteresis 1) without a crystallisation branch: its
+            # range lies below 0 K, where xi_k(T) = 0 at every temperature (KINETICS_RANGE_K)
             lo, hi = v if v is not None else (m.crystallization_C, m.melt_C)
-            vals["hysteresis"] = int(v is not None)
-            vals["crystallization_low_K"] = lo + KELVIN
-            vals["crystallization_high_K"] = hi + KELVIN
+            kinetic = m.crystallization_kinetics is not None
+            vals["hysteresis"] = int(v is not None or kinetic)
+            vals["crystallization_low_K"] = KINETICS_RANGE_K[0] if kinetic else lo + KELVIN
+            vals["crystallization_high_K"] = KINETICS_RANGE_K[1] if kinetic else hi + KELVIN
+        elif key == "crystallization_kinetics":
+            # Nakamura's rate law in SI (a material without kinetics carries the PA12 defaults,
+            # never read: kinetics = 0)
+            kin = v if v is not None else CrystallizationKinetics().model_dump()
+            vals["kinetics"] = int(v is not None)
+            vals["kinetics_n"] = kin["n"]
+            vals["kinetics_inv_t_half_0_1_s"] = kin["inv_t_half_0_1_s"]
+            vals["kinetics_U_J_mol"] = kin["U_J_mol"]
+            vals["kinetics_T_inf_K"] = kin["T_inf_C"] + KELVIN
+            vals["kinetics_T_m0_K"] = kin["T_m0_C"] + KELVIN
+            vals["kinetics_K_g_K2"] = kin["K_g_K2"]
         else:
             vals[key] = v
     T_c, T_m = vals["crystallization_K"], vals["melt_K"]

@@ -44,6 +44,7 @@ from ..physics.mechanics import (
 from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
+    counts_molten,
     g2p_heat,
     grid_heat,
     grid_temperature,
@@ -246,15 +247,13 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             chi = st.cfg.subgrid_filter
             if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
                 chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
-            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi)
+            dt_heat = heat_step(st)  # = dt heat_every explicit; dt_heat[None] implicit
+            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
             if ti.static(st.cfg.any_fixed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
-            if pt.solid_fraction[p] == 0.0:  # above T_m for this heat step
-                if ti.static(st.cfg.implicit):
-                    pt.time_molten[p] += st.scalars.dt_heat[None]
-                else:
-                    pt.time_molten[p] += dt * st.cfg.heat_every
+            if counts_molten(st.cfg, mat[pt.material[p]], pt.solid_fraction[p]):
+                pt.time_molten[p] += dt_heat
             if ti.static(st.cfg.th_strain and st.cfg.mech):
                 if ti.static(st.cfg.implicit):  # the step's strain: the sum over its substeps
                     inc = thermal_strain_increment(pt, mat, p, dT, dxi)

@@ -99,6 +99,7 @@ class StepConfig:
     subgrid_rate: float  # its rate (1/s): chi = 1 - exp(-rate dt_heat) for a varying heat step
     heat_implicit: bool  # time.heat_integrator = "implicit" (solver/implicit_heat.py)
     hysteresis: bool  # some material crystallises below its melting range (physics/thermal.py)
+    kinetics: bool  # some material crystallises by kinetics (hysteresis too; physics/thermal.py)
     # ---- mass and surface tension
     surface_method: SurfaceMethod
     se: SurfaceEnergyConfig
@@ -226,7 +227,12 @@ def step_config(
         subgrid_rate=case.thermal.subgrid_filter / thermal_limit if thermal else 0.0,
         heat_implicit=case.implicit_heat(),
         hysteresis=thermal
-        and any(m.crystallization_range_C is not None for m in case.materials.values()),
+        and any(
+            m.crystallization_range_C is not None or m.crystallization_kinetics is not None
+            for m in case.materials.values()
+        ),
+        kinetics=thermal
+        and any(m.crystallization_kinetics is not None for m in case.materials.values()),
         surface_method=method,
         se=SurfaceEnergyConfig(
             weight_lp=h / (2 * case.grid.points_per_cell)

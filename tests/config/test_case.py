@@ -91,6 +91,20 @@ BAD = [
     ({"materials": {"PA12": {"crystallization_range_C": [140.0, 150.0]}}}, "range_C"),
     ({"materials": {"PA12": {"crystallization_range_C": [140.0, 130.0]}}}, "range_C"),
     ({"materials": {"PA12": {"crystallization_range_C": [140.0]}}}, "range_C"),
+    (
+        {
+            "materials": {
+                "PA12": {"crystallization_kinetics": {}, "crystallization_range_C": [1, 2]}
+            }
+        },
+        "materials.PA12.crystallization_kinetics",
+    ),
+    ({"materials": {"PA12": {"crystallization_kinetics": {"n": 0.5}}}}, "kinetics.n"),
+    ({"materials": {"PA12": {"crystallization_kinetics": {"K_g": 1.0}}}}, "kinetics.K_g"),
+    (
+        {"materials": {"PA12": {"crystallization_kinetics": {"T_inf_C": 250.0}}}},
+        "crystallization_kinetics.T_inf_C = 250.0",
+    ),
     ({"bodies": [{"shape": "disc", "center_um": [10.0, 20.0], "radius_um": 20.0}]}, "bodies[0]"),
     ({"bodies": [{"shape": "star"}]}, "bodies[0].shape"),
     ({"bodies": [{"material": "steel"}]}, "bodies[0].material"),

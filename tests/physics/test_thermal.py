@@ -296,19 +296,23 @@ def test_hysteresis_block_crystallises_below_its_range():
 
 
 def test_unset_hysteresis_is_the_paper_model_bitwise():
-    """A material with the option that no body uses compiles the hysteresis path; the bodies'
-    material without it keeps the single range, bitwise the run without the option (the
+    """A material with the option (or with crystallisation kinetics) that no body uses compiles
+    the hysteresis (and kinetics) path; the bodies' material without it keeps the single range,
+    bitwise the run without the option (the
     25 W pair on a fixed plate: melting and refreezing beside the plate). Strict IEEE order:
     fast math contracts the two compiled paths differently (measured: 3e-13 K apart)."""
     out = []
-    for extra in ({}, {"HYST": {**HYSTERESIS}}):
+    kinetics = {"KIN": {**MELT_RANGE, "crystallization_kinetics": {}}}
+    for extra in ({}, {"HYST": {**HYSTERESIS}}, kinetics):  # the kinetics path too
         data = _laser_case(True).model_dump()
         case = make_case(deep_update(data, {"materials": extra, "solver": {"fast_math": False}}))
         sim = Simulation(case)
         assert sim.state.cfg.hysteresis == bool(extra)
+        assert sim.state.cfg.kinetics == ("KIN" in extra)
         sim.advance(400)
         pt = sim.state.points
         out.append([pt.T.to_numpy(), pt.solid_fraction.to_numpy(), pt.x.to_numpy()])
     assert out[0][1].min() == 0.0  # the pair melted
-    for a, b in zip(*out, strict=True):
-        assert np.array_equal(a, b)
+    for run in out[1:]:
+        for a, b in zip(out[0], run, strict=True):
+            assert np.array_equal(a, b)

@@ -12,7 +12,8 @@ dT = T_m0 - T, f = 2 T / (T + T_m0), K_N = (ln 2)^(1/n) / t_1/2.
 
 :data:`PA12_CRYSTALLIZATION` holds the PA12 values of docs/pa12_process.md; which of them are
 measured and which are modelling choices is said there and in :class:`CrystallizationKinetics`.
-Not used by the solver yet.
+The solver's kernels evaluate the same law per point (physics/materials.py, the option
+``materials.NAME.crystallization_kinetics``); this module is their host-side reference.
 """
 
 from __future__ import annotations
