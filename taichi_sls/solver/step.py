@@ -49,6 +49,7 @@ from ..physics.thermal import (
     grid_temperature,
     p2g_heat_capacity,
     p2g_heat_flux,
+    top_loss_column,
 )
 from .fields import State
 from .loops import (
@@ -216,9 +217,23 @@ def _heat_flux_loop(st: ti.template()):
 
 
 @ti.func
+def _top_loss_loop(st: ti.template()):
+    """The top surface's loss to the chamber, column by column; its total summed in column
+    order (one thread), so that it repeats bit for bit."""
+    dt_heat = heat_step(st)
+    rows = active(st.box)[1]
+    if ti.static(st.cfg.parallel):
+        ti.loop_config(serialize=True)
+    for i in range(active(st.box)[0][0], active(st.box)[0][1]):
+        st.scalars.heat_out[None] += top_loss_column(st.cfg, st.nodes, i, rows[0], rows[1], dt_heat)
+
+
+@ti.func
 def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(st.cfg.thermal):
         on_clock(st, heat, _heat_flux_loop)
+        if ti.static(st.cfg.top_loss):
+            on_clock(st, heat, _top_loss_loop)
 
 
 @ti.func
