@@ -49,7 +49,6 @@ from ..physics.thermal import (
     grid_temperature,
     p2g_heat_capacity,
     p2g_heat_flux,
-    top_loss_column,
 )
 from .fields import State
 from .loops import (
@@ -57,9 +56,11 @@ from .loops import (
     add_laser_energy,
     check_block,
     grow_box,
+    heat_step,
     peak_temperature,
     point_loop,
     reduce_blocks,
+    top_loss_in_order,
     wall_heat_in_order,
 )
 
@@ -189,18 +190,6 @@ def _csf_mass(st: ti.template()):
 
 
 @ti.func
-def heat_step(st: ti.template()):
-    """The heat step: heat_every mechanical steps; implicit: the step over its heat substeps
-    (solver/implicit.py)."""
-    dt_heat = 0.0
-    if ti.static(st.cfg.implicit):
-        dt_heat = st.scalars.dt_heat[None]
-    else:
-        dt_heat = st.scalars.dt[None] * st.cfg.heat_every
-    return dt_heat
-
-
-@ti.func
 def _heat_flux_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     dt_heat = heat_step(st)
     t = st.scalars.t[None]
@@ -217,23 +206,11 @@ def _heat_flux_loop(st: ti.template()):
 
 
 @ti.func
-def _top_loss_loop(st: ti.template()):
-    """The top surface's loss to the chamber, column by column; its total summed in column
-    order (one thread), so that it repeats bit for bit."""
-    dt_heat = heat_step(st)
-    rows = active(st.box)[1]
-    if ti.static(st.cfg.parallel):
-        ti.loop_config(serialize=True)
-    for i in range(active(st.box)[0][0], active(st.box)[0][1]):
-        st.scalars.heat_out[None] += top_loss_column(st.cfg, st.nodes, i, rows[0], rows[1], dt_heat)
-
-
-@ti.func
 def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(st.cfg.thermal):
         on_clock(st, heat, _heat_flux_loop)
         if ti.static(st.cfg.top_loss):
-            on_clock(st, heat, _top_loss_loop)
+            on_clock(st, heat, top_loss_in_order)
 
 
 @ti.func
