@@ -242,6 +242,33 @@ class Case(Model):
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
+            if las.scan == "along" and las.tracks > 1:
+                raise CaseError(
+                    f'lasers[{i}].tracks = {las.tracks}: hatches need scan = "across" '
+                    '(allowed with scan = "along": 1)'
+                )
+            if las.scan == "across":
+                if las.speed_m_s <= 0.0:
+                    raise CaseError(
+                        f'lasers[{i}].speed_m_s = {las.speed_m_s}: scan = "across" needs the '
+                        "speed along the tracks (allowed: > 0)"
+                    )
+                if las.x_end_um is not None:
+                    raise CaseError(
+                        f'lasers[{i}].x_end_um = {las.x_end_um}: not used with scan = "across" '
+                        "(the tracks end where tracks and hatch_um put them; allowed: unset)"
+                    )
+                if las.tracks > 1 and las.return_s is None:
+                    raise CaseError(
+                        f"lasers[{i}].return_s = None: {las.tracks} tracks need the time "
+                        "between their passes (allowed: > 0 s)"
+                    )
+                passage = 6e-6 * las.spot_radius_um / las.speed_m_s
+                if las.tracks > 1 and las.return_s < passage:
+                    raise CaseError(
+                        f"lasers[{i}].return_s = {las.return_s}: shorter than a pass, 6 r0 / v "
+                        f"= {passage:g} s (allowed: >= {passage:g})"
+                    )
         if self.solver.stress_reading == "paper" and self.solver.strain == "finite":
             raise CaseError(
                 'solver.stress_reading = "paper" with solver.strain = "finite": the printed '
@@ -318,7 +345,9 @@ class Case(Model):
         ends = [0.0]
         for las in self.lasers:
             end = las.off_s
-            if las.speed_m_s != 0.0 and las.x_end_um is not None:
+            if las.scan == "across":
+                end = min(end, las.track_windows_s()[-1][1])
+            elif las.speed_m_s != 0.0 and las.x_end_um is not None:
                 end = min(end, las.on_s + (las.x_end_um - las.x_start_um) * 1e-6 / las.speed_m_s)
             ends.append(max(end, las.on_s) if las.power_W > 0 else 0.0)
         return max(ends)

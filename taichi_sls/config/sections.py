@@ -176,6 +176,35 @@ class Thermal(Model):
         "Increments alone never damp it, and stirred by the flow it grew to 6 K below the plate "
         "over 30 ms; rates of 3 and more overshoot at a sharp front; 0: increments alone (FLIP)",
     )
+    top_surface: Literal["insulated", "chamber"] = Field(
+        "insulated",
+        description="the layer's top surface: insulated (no heat crosses it); chamber: it loses "
+        "q = convection_W_m2K (T - T_ch) + emissivity sigma (T^4 - T_ch^4) per area to the "
+        "chamber at chamber_C, through each grid column's projected width, from the top three "
+        "nodes of the column that hold material (docs/model.md, 'Top-surface heat loss')",
+    )
+    chamber_C: float | None = Field(
+        None,
+        description="top_surface = chamber: the chamber temperature T_ch (C); default initial_C",
+    )
+    emissivity: float = Field(
+        0.92,
+        ge=0,
+        le=1,
+        description="top_surface = chamber: the surface's emissivity (PA12 0.90-0.92, "
+        "docs/pa12_process.md)",
+    )
+    convection_W_m2K: float = Field(
+        0.0, ge=0, description="top_surface = chamber: the convection coefficient h (W/(m^2 K))"
+    )
+
+    def chamber_temperature_C(self) -> float:
+        """T_ch (C): chamber_C, or the initial temperature."""
+        return self.initial_C if self.chamber_C is None else self.chamber_C
+
+
+# scan = across: a pass heats the plane while its spot centre is within this many spot radii
+PASS_HALF_WIDTH = 3.0
 
 
 class Laser(Model):
@@ -188,8 +217,31 @@ class Laser(Model):
     depth_factor: float = Field(0.6, ge=0, description="the 0.6 prefactor of eq. 31")
     on_s: float = Field(0.0, ge=0, description="switch-on time (s)")
     off_s: float = Field(20e-6, ge=0, description="switch-off time (s)")
-    x_start_um: float = Field(40.0, description="beam centre at on_s (um)")
-    speed_m_s: float = Field(0.0, description="scan speed along +x (m/s); 0 = stationary")
+    x_start_um: float = Field(
+        40.0, description="beam centre at on_s (um); scan = across: the first track's x (um)"
+    )
+    speed_m_s: float = Field(
+        0.0,
+        description="scan speed along +x (m/s); 0 = stationary. scan = across: the speed along "
+        "the tracks, normal to the plane (> 0)",
+    )
+    scan: Literal["along", "across"] = Field(
+        "along",
+        description="along: the plane contains the track, the spot moves in x at speed_m_s; "
+        "across: the plane is a section across parallel tracks (hatches): track k (k < tracks) "
+        "runs normal to the plane at x_start_um + k hatch_um and its spot passes through the "
+        "plane at speed_m_s, crossing it at on_s + 3 r0 / v + k return_s; each pass delivers the "
+        "line energy A P / v, so the mean energy per area is A P / (v hatch) (docs/model.md, "
+        "'Hatches')",
+    )
+    tracks: int = Field(1, ge=1, le=1000, description="scan = across: number of tracks")
+    hatch_um: float = Field(100.0, gt=0, description="scan = across: hatch distance (um)")
+    return_s: float | None = Field(
+        None,
+        gt=0,
+        description="scan = across: time between successive tracks' passes through the plane "
+        "(s; a machine's track length / speed plus its turn); needed for tracks > 1",
+    )
     x_end_um: float | None = Field(
         None, description="beam switches off when its centre passes this x"
     )
@@ -206,6 +258,21 @@ class Laser(Model):
         description="decay: exp(-(y_l - y)/eta) (docs/model.md); paper: exp(+(y_l - y)/eta) as "
         "printed",
     )
+
+    def pass_half_s(self) -> float:
+        """scan = across: half the time a pass heats the plane (s), PASS_HALF_WIDTH r0 / v; the
+        Gaussian beyond it carries erfc(3 sqrt 2) / 2 = 1e-9 of a pass's energy."""
+        return PASS_HALF_WIDTH * self.spot_radius_um * 1e-6 / self.speed_m_s
+
+    def track_windows_s(self) -> list[tuple[float, float]]:
+        """scan = across: each track's heating window (s), centred on its crossing time
+        on_s + pass_half_s + k return_s and cut to [on_s, off_s]."""
+        half = self.pass_half_s()
+        out = []
+        for k in range(self.tracks):
+            tc = self.on_s + half + k * (self.return_s or 0.0)
+            out.append((max(tc - half, self.on_s), max(min(tc + half, self.off_s), self.on_s)))
+        return out
 
 
 class Output(Model):

@@ -38,7 +38,7 @@ from ..solver.guard import SimulationError
 from ..solver.scene import Scene
 from ..solver.simulation import Simulation
 from .bed_outcome import ContactHistory, bed_monitors, bed_summary, describe_bed, is_bed
-from .outcome import NeckHistory, describe, neck_region, outcome
+from .outcome import NeckHistory, describe, laser_acted, neck_region, outcome
 from .progress import Progress
 from .schedule import SETTLED_FRAMES, frame_steps, reached, settled, step_towards
 from .settle import settle
@@ -207,6 +207,7 @@ def run_case(
         T_c=min(m.solid_below_C() for m in case.materials.values()),
         T_wall=min(walls) if walls else math.nan,
         adaptive=sim.adaptive is not None,
+        lasers_off_s=case.lasers_off_s() if laser_acted(case) else math.nan,
     )
     step_wall = 0.0
     steps0 = sim.steps

@@ -1,5 +1,6 @@
 """The progress bar of a run: simulated time against the horizon (end_s, or max_s for a run to
-solidification), steps per second, the molten fraction, and an estimate of the time left."""
+solidification), the phase of a process cycle (scan, then hold once every laser is off), steps
+per second, the molten fraction, and an estimate of the time left."""
 
 from __future__ import annotations
 
@@ -25,12 +26,14 @@ class Progress:
         T_c: float = math.nan,
         T_wall: float = math.nan,
         adaptive: bool = False,
+        lasers_off_s: float = math.nan,
     ) -> None:
         self._bar = None
         # an adaptive step grows by orders of magnitude: the pace so far says nothing of the
         # time left, so the bar shows the step instead
         self.adaptive = adaptive
         self.horizon = horizon_s
+        self.lasers_off_s = lasers_off_s  # nan: no laser heats, no phases to show
         self.solidify, self.T_c, self.T_wall = solidify, T_c, T_wall
         self._molten: float | None = None
         self._cooling: list[tuple[float, float]] = []  # (t, T_max) once T_max falls
@@ -53,6 +56,8 @@ class Progress:
             return
         self._bar.n = round(min(t, self.horizon) * 1e6, 3)
         text = f"{steps_per_s:,.0f} steps/s"
+        if math.isfinite(self.lasers_off_s):  # the layer's phase: scanned, then held
+            text = ("hold, " if t >= self.lasers_off_s else "scan, ") + text
         if self._molten is not None:
             text += f", molten {self._molten:.0%}"
         left = math.nan if self.adaptive else self.time_left(t)

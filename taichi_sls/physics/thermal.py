@@ -38,6 +38,15 @@ increment; the heat that reaches them leaves the body and is counted in ``heat_o
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature
 (docs/model.md: resetting the nodes by increments drove points beside the plate to 110 C).
 
+Top-surface loss (``cfg.top_loss``, ``thermal.top_surface = "chamber"``): the layer's top surface
+loses q(T) = h_c (T - T_ch) + eps sigma (T^4 - T_ch^4) per area to the chamber. Each node column
+is exposed over its share of the domain's width (its projected top, the area a rough surface
+presents to the chamber); T is the capacity-weighted temperature of the column's top three nodes
+(the topmost holding material and the two below it, fixed ones excluded), and the column's loss
+is taken from them in proportion to their capacities, so the skin cools as one. It enters the
+nodes' heat rate as the laser's heat does, and is counted in ``heat_out``: the energy balance
+still holds to round-off.
+
 Arguments: ``cfg`` the step's configuration, ``pt`` points, ``nd`` nodes, ``mat`` materials,
 ``sc`` the run's scalars (heat out through the walls' nodes), ``lasers`` the beams. The point
 functions return what a point adds to the run's totals (laser energy, heat out); the solver
@@ -63,6 +72,9 @@ from .materials import (
 )
 from .shape import STENCIL_SHAPE, node_weight
 from .small_matrix import ZERO_VECTOR
+
+STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4)
+SKIN_NODES = 3  # the top nodes of a column that lose the top surface's heat
 
 
 @ti.func
@@ -186,6 +198,47 @@ def p2g_heat_flux(
         N, gN = node_weight(w, dw, o)
         scatter_add(cfg, nd.heat_rate, base + o, -Vp * k * gT.dot(gN) + Vp * s * N)
     return energy
+
+
+@ti.func
+def surface_flux(cfg: ti.template(), T):
+    """q (W/m^2) that the top surface at T (K) loses to the chamber."""
+    Tc = cfg.chamber_T
+    return cfg.convection * (T - Tc) + cfg.emissivity * STEFAN_BOLTZMANN * (T**4 - Tc**4)
+
+
+@ti.func
+def top_loss_column(cfg: ti.template(), nd: ti.template(), i, j_lo, j_hi, dt):
+    """Take column i's top-surface loss over dt from its skin nodes' heat rates (module
+    docstring); returns the heat lost (J per depth). Rows j_lo <= j < j_hi hold the material."""
+    x = (i - cfg.off) * cfg.h
+    width = ti.max(ti.min(x + 0.5 * cfg.h, cfg.ncx * cfg.h) - ti.max(x - 0.5 * cfg.h, 0.0), 0.0)
+    top = j_lo - 1
+    for jj in range(j_hi - j_lo):  # from the top down to the first node holding material
+        j = j_hi - 1 - jj
+        if top < j_lo and nd.heat_capacity[i, j] > 0.0:
+            top = j
+    lost = 0.0
+    if top >= j_lo and width > 0.0:
+        C = 0.0
+        CT = 0.0
+        for k in range(SKIN_NODES):
+            j = top - k
+            if j >= j_lo:
+                fixed, Tw = fixed_temperature(cfg, ti.Vector([i, j]))
+                if not fixed:
+                    C += nd.heat_capacity[i, j]
+                    CT += nd.heat_capacity[i, j] * nd.T[i, j]
+        if C > 0.0:
+            rate = width * surface_flux(cfg, CT / C)  # W per depth
+            for k in range(SKIN_NODES):
+                j = top - k
+                if j >= j_lo:
+                    fixed, Tw = fixed_temperature(cfg, ti.Vector([i, j]))
+                    if not fixed:
+                        nd.heat_rate[i, j] -= rate * nd.heat_capacity[i, j] / C
+            lost = rate * dt
+    return lost
 
 
 @ti.func

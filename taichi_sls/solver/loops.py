@@ -9,7 +9,7 @@ from taichi_sls.backend import ti
 
 from ..physics.grid import active
 from ..physics.shape import stencil, stencil_base
-from ..physics.thermal import wall_heat
+from ..physics.thermal import top_loss_column, wall_heat
 from .blocks import MARGIN, SIDE
 from .step_config import Layout
 
@@ -94,6 +94,30 @@ def wall_heat_in_order(st: ti.template(), dt_heat):
     ti.loop_config(serialize=True)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         st.scalars.heat_out[None] += wall_heat(st.cfg, st.nodes, I, dt_heat)
+
+
+@ti.func
+def heat_step(st: ti.template()):
+    """The heat step: heat_every mechanical steps; implicit: the step over its heat substeps
+    (solver/implicit.py)."""
+    dt_heat = 0.0
+    if ti.static(st.cfg.implicit):
+        dt_heat = st.scalars.dt_heat[None]
+    else:
+        dt_heat = st.scalars.dt[None] * st.cfg.heat_every
+    return dt_heat
+
+
+@ti.func
+def top_loss_in_order(st: ti.template()):
+    """The top surface's loss to the chamber (physics/thermal.py), column by column; its total
+    summed in column order by one thread, so that it repeats bit for bit."""
+    dt_heat = heat_step(st)
+    cols, rows = active(st.box)
+    if ti.static(st.cfg.parallel):
+        ti.loop_config(serialize=True)
+    for i in range(cols[0], cols[1]):
+        st.scalars.heat_out[None] += top_loss_column(st.cfg, st.nodes, i, rows[0], rows[1], dt_heat)
 
 
 @ti.func

@@ -96,6 +96,11 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
                 spot_radius_m=r0,
                 penetration_depth_m=eta,
                 depth_sign=1.0 if las.depth_sign == "decay" else -1.0,
+                across=1.0 if las.scan == "across" else 0.0,
+                tracks=float(las.tracks),
+                hatch_m=las.hatch_um * 1e-6,
+                return_s=las.return_s or 0.0,
+                pass_half_s=las.pass_half_s() if las.scan == "across" else 0.0,
             )
         )
     return {k: np.array([r[k] for r in rows], dtype=float) for k in LASER_MEMBERS}

@@ -57,10 +57,12 @@ from .loops import (
     add_laser_energy,
     check_block,
     grow_box,
+    heat_step,
     peak_temperature,
     point_loop,
     point_stencil,
     reduce_blocks,
+    top_loss_in_order,
     wall_heat_in_order,
 )
 
@@ -180,18 +182,6 @@ def _csf_mass(st: ti.template()):
 
 
 @ti.func
-def heat_step(st: ti.template()):
-    """The heat step: heat_every mechanical steps; implicit: the step over its heat substeps
-    (solver/implicit.py)."""
-    dt_heat = 0.0
-    if ti.static(st.cfg.implicit):
-        dt_heat = st.scalars.dt_heat[None]
-    else:
-        dt_heat = st.scalars.dt[None] * st.cfg.heat_every
-    return dt_heat
-
-
-@ti.func
 def _heat_flux_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     dt_heat = heat_step(st)
     t = st.scalars.t[None]
@@ -211,6 +201,8 @@ def _heat_flux_loop(st: ti.template()):
 def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(st.cfg.thermal):
         on_clock(st, heat, _heat_flux_loop)
+        if ti.static(st.cfg.top_loss):
+            on_clock(st, heat, top_loss_in_order)
 
 
 @ti.func

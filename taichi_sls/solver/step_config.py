@@ -98,6 +98,10 @@ class StepConfig:
     subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
     subgrid_rate: float  # its rate (1/s): chi = 1 - exp(-rate dt_heat) for a varying heat step
     heat_implicit: bool  # time.heat_integrator = "implicit" (solver/implicit_heat.py)
+    top_loss: bool  # thermal.top_surface = "chamber" (physics/thermal.py)
+    chamber_T: float  # K
+    emissivity: float
+    convection: float  # W/(m^2 K)
     hysteresis: bool  # some material crystallises below its melting range (physics/thermal.py)
     kinetics: bool  # some material crystallises by kinetics (hysteresis too; physics/thermal.py)
     # ---- mass and surface tension
@@ -226,6 +230,10 @@ def step_config(
         else 0.0,
         subgrid_rate=case.thermal.subgrid_filter / thermal_limit if thermal else 0.0,
         heat_implicit=case.implicit_heat(),
+        top_loss=thermal and case.thermal.top_surface == "chamber",
+        chamber_T=case.thermal.chamber_temperature_C() + KELVIN,
+        emissivity=case.thermal.emissivity,
+        convection=case.thermal.convection_W_m2K,
         hysteresis=thermal
         and any(
             m.crystallization_range_C is not None or m.crystallization_kinetics is not None
