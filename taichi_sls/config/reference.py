@@ -29,7 +29,7 @@ def sections() -> list[tuple[str, type[BaseModel]]]:
         elif name == "materials":
             out.append(("materials.NAME", Material))
         elif name == "boundary":
-            out.append(("boundary.left / right / bottom / top", Wall))
+            out.append(("boundary.left / right / bottom / top / front / back", Wall))
         elif name == "lasers":
             out.append(("[[lasers]]", typing.get_args(f.annotation)[0]))
         else:

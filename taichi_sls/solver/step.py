@@ -69,7 +69,7 @@ def point_stencil(cfg: ti.template(), pt: ti.template(), p):
     # A point that has left the grid (or become NaN) must not write outside the arrays: clamp
     # its stencil; the guard reports it at the next frame. The 2-cell padding keeps every point
     # of a healthy run far from this bound.
-    base = ti.max(ti.min(base, ti.Vector([cfg.nx - 4, cfg.ny - 4])), 1)
+    base = ti.max(ti.min(base, ti.Vector(cfg.shape) - 4), 1)
     return base, w, dw
 
 
@@ -297,7 +297,7 @@ def watch(st: ti.template(), p):
     if pt.J[p] <= 0.0:
         ti.atomic_min(sc.first_inverted[None], k)
     x = pt.x[p]
-    if not (x[0] == x[0] and x[1] == x[1] and pt.J[p] == pt.J[p]):
+    if not ((x == x).all() and pt.J[p] == pt.J[p]):
         ti.atomic_min(sc.first_nan[None], k)
 
 
