@@ -199,8 +199,8 @@ class Thermal(Model):
         1.0,
         ge=0,
         description="rate of the sub-grid temperature filter, in units of 1 / the thermal "
-        "stability limit h^2 rho c / 4k (2D; 6k in 3D): each heat step removes "
-        "1 - exp(-rate dt_heat / limit) "
+        "stability limit h^2 rho c / 4k, in 3D too (its own limit is 2/3 of that): each heat "
+        "step removes 1 - exp(-rate dt_heat / limit) "
         "of the points' sub-grid temperature noise (energy-conserving; physics/thermal.py). "
         "Increments alone never damp it, and stirred by the flow it grew to 6 K below the plate "
         "over 30 ms; rates of 3 and more overshoot at a sharp front; 0: increments alone (FLIP)",
