@@ -161,11 +161,9 @@ class Simulation(NeckMeasures):
             T_floor_K=coldest + KELVIN if case.physics.thermal else -math.inf,
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
-        # the neck sections are 2D (issue #39): a 3D run reports contact_line_um as NaN
-        two_d = case.domain.dim == 2
+        two_d = case.domain.dim == 2  # neck sections are 2D (issue #39): 3D reports them NaN
         self._pair = len(case.bodies) >= 2 and two_d
-        # the contacts, found once on the seeded points; each body's reach for the neck
-        # sections is its equivalent radius sqrt(area / pi)
+        # the contacts, found once on the seeded points; each body's neck reach sqrt(area / pi)
         sc = self.scene
         self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell) if two_d else []
         area = np.bincount(sc.body, weights=sc.vol)
@@ -334,8 +332,7 @@ class Simulation(NeckMeasures):
         return (net - rise) / (abs(self._H0) + mon["laser_energy_J_per_m"])
 
     def surface_energy(self) -> float:
-        """gamma times the bodies' outline as seeded (J/m; 3D: their surface, J): the scale of
-        the kinetic ratio."""
+        """gamma times the bodies' outline as seeded (J/m; 3D: surface, J): kinetic ratio scale."""
         gamma = max(m.surface_tension_N_m for m in self.case.materials.values())
         return max(gamma * self.case.outline_um() * 1e-6 ** (self.state.cfg.dim - 1), 1e-30)
 
@@ -345,8 +342,7 @@ class Simulation(NeckMeasures):
         if self._e_static is None:
             c = self.case
             gamma = max(m.surface_tension_N_m for m in c.materials.values())
-            g = math.hypot(*c.physics.gravity_m_s2)
-            M = float(self._mass.sum())
+            g, M = math.hypot(*c.physics.gravity_m_s2), float(self._mass.sum())
             v0 = self.point_arrays()["v"]
             ke0 = 0.5 * float((self._mass * (v0**2).sum(axis=1)).sum())
             surface = gamma * c.outline_um() * 1e-6 ** (c.domain.dim - 1)
