@@ -11,7 +11,7 @@ import numpy as np
 from pydantic import Field, field_validator
 
 from .layer_file import read_layer
-from .model import Model, Pair
+from .model import Model, Pair, Point
 
 
 class BodyBase(Model):
@@ -19,12 +19,17 @@ class BodyBase(Model):
     temperature_C: float | None = Field(
         None, description="initial temperature; default thermal.initial_C"
     )
-    velocity_m_s: Pair = Field([0.0, 0.0], description="initial velocity (m/s)")
+    velocity_m_s: Point = Field(
+        [0.0, 0.0],
+        description="initial velocity (m/s); [vx, vy], in 3D also [vx, vy, vz] (vz = 0 without)",
+    )
 
 
 class Disc(BodyBase):
     shape: Literal["disc"] = Field("disc", description="disc, rect, polygon or points")
-    center_um: Pair = Field([20.0, 20.0], description="disc centre (um)")
+    center_um: Point = Field(
+        [20.0, 20.0], description="disc centre (um); [x, y] in 2D, [x, y, z] in 3D (a sphere)"
+    )
     radius_um: float = Field(20.0, gt=0, description="disc radius (um)")
     perturbation: float = Field(
         0.0,
@@ -35,23 +40,36 @@ class Disc(BodyBase):
     mode: int = Field(2, ge=2, description="shape mode n >= 2 of the perturbation")
 
     def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        (cx, cy), r = self.center_um, self.radius_um * (1.0 + abs(self.perturbation))
-        return (cx - r, cy - r), (cx + r, cy + r)
+        r = self.radius_um * (1.0 + abs(self.perturbation))
+        return tuple(c - r for c in self.center_um), tuple(c + r for c in self.center_um)
 
     def perimeter_um(self) -> float:
         return 2 * math.pi * self.radius_um
 
+    def area_um2(self) -> float:
+        """The surface of the sphere that a disc with a 3D centre is."""
+        return 4 * math.pi * self.radius_um**2
+
 
 class Rect(BodyBase):
     shape: Literal["rect"] = Field(description="disc, rect, polygon or points")
-    min_um: Pair = Field([0.0, 0.0], description="rectangle lower-left corner (um)")
-    max_um: Pair = Field([10.0, 10.0], description="rectangle upper-right corner (um)")
+    min_um: Point = Field(
+        [0.0, 0.0], description="rectangle lower-left corner (um); [x, y, z] in 3D (a box)"
+    )
+    max_um: Point = Field(
+        [10.0, 10.0], description="rectangle upper-right corner (um); [x, y, z] in 3D (a box)"
+    )
 
     def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        return (self.min_um[0], self.min_um[1]), (self.max_um[0], self.max_um[1])
+        return tuple(self.min_um), tuple(self.max_um)
 
     def perimeter_um(self) -> float:
         return 2 * (self.max_um[0] - self.min_um[0] + self.max_um[1] - self.min_um[1])
+
+    def area_um2(self) -> float:
+        """The surface of the box that a rect with 3D corners is."""
+        a, b, c = (hi - lo for lo, hi in zip(self.min_um, self.max_um, strict=True))
+        return 2 * (a * b + b * c + c * a)
 
 
 class Polygon(BodyBase):

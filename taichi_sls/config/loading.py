@@ -144,8 +144,10 @@ def in_file(path: Path, build: Callable[[dict], T], data: dict) -> T:
 
 
 def case_to_dict(case: Case) -> dict:
-    """The resolved case as plain data (None values dropped: TOML has no null)."""
-    return case.model_dump(exclude_none=True)
+    """The resolved case as plain data (None values dropped: TOML has no null; a 2D case has no
+    walls in z)."""
+    z_walls = {"boundary": {"front", "back"}} if case.domain.dim == 2 else None
+    return case.model_dump(exclude_none=True, exclude=z_walls)
 
 
 def case_to_toml(case: Case) -> str:

@@ -2,7 +2,7 @@
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 
 class Model(BaseModel):
@@ -14,3 +14,13 @@ class Model(BaseModel):
 
 # an [x, y] pair as TOML writes it (a list)
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
+
+
+def _two_or_three(v: list[float]) -> list[float]:
+    if len(v) not in (2, 3):
+        raise ValueError("expected [x, y] (2D) or [x, y, z] (3D)")
+    return v
+
+
+# a position or vector: [x, y] in 2D, [x, y, z] in 3D (the case checks the count against domain.dim)
+Point = Annotated[list[float], AfterValidator(_two_or_three)]

@@ -30,7 +30,7 @@ def sections() -> list[tuple[str, type[BaseModel]]]:
             out.append(("materials.NAME", Material))
             out.append(("materials.NAME.crystallization_kinetics", CrystallizationKinetics))
         elif name == "boundary":
-            out.append(("boundary.left / right / bottom / top", Wall))
+            out.append(("boundary.left / right / bottom / top / front / back", Wall))
         elif name == "lasers":
             out.append(("[[lasers]]", typing.get_args(f.annotation)[0]))
         else:

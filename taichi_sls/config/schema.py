@@ -16,6 +16,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from .bed import Bed, bed_discs
 from .bodies import Body, Disc, LayerBody
+from .dim import check_dimension
 from .errors import CaseError
 from .layer_file import read_layer
 from .materials import Material
@@ -176,18 +177,20 @@ class Case(Model):
     @model_validator(mode="after")
     def _cross_checks(self) -> Case:
         """What a field type alone cannot express."""
+        check_dimension(self)
         check_overlaps(self.bodies, self.contact.allow_overlap)  # the case's own, before the bed
         self._expand_bed()
         if not self.bodies:
             raise CaseError(f"bodies = []: {NO_BODIES}")
-        W, Hh = self.domain.width_um, self.domain.height_um
+        sides = self.domain_um()
         h = self.grid.spacing_um
-        if h > min(W, Hh) / 2:
+        if h > min(sides) / 2:
             raise CaseError(f"grid.spacing_um = {h}: must be at most half the smaller domain side")
-        cells = (W / h) * (Hh / h)
+        cells = math.prod(s / h for s in sides)
         if cells > MAX_CELLS:
             raise CaseError(
-                f"grid.spacing_um = {h}: {cells:.3g} cells in a {W} x {Hh} um domain; at most "
+                f"grid.spacing_um = {h}: {cells:.3g} cells in a "
+                f"{' x '.join(f'{s}' for s in sides)} um domain; at most "
                 f"{MAX_CELLS:.0e} are allowed (memory)"
             )
         for name, m in self.materials.items():
@@ -214,7 +217,7 @@ class Case(Model):
                     f"with T_low < T_high <= crystallization_C = {m.crystallization_C} (the "
                     "crystallisation range lies below the melting range, without overlap)"
                 )
-        eps = 1e-9 * max(W, Hh)
+        eps = 1e-9 * max(sides)
         for i, b in enumerate(self.bodies):
             key = f"bodies[{i}]"
             if b.material not in self.materials:
@@ -222,7 +225,8 @@ class Case(Model):
                     f"{key}.material = {b.material!r}: no such material; defined: "
                     f"{', '.join(self.materials)}"
                 )
-            if b.shape == "rect" and not (b.max_um[0] > b.min_um[0] and b.max_um[1] > b.min_um[1]):
+            rect = b.shape == "rect"
+            if rect and not all(c > a for a, c in zip(b.min_um, b.max_um, strict=True)):
                 raise CaseError(f"{key}.max_um = {b.max_um}: must exceed min_um = {b.min_um}")
             if b.shape == "points" and len(b.points_um()[1]) == 0:
                 raise CaseError(
@@ -234,10 +238,11 @@ class Case(Model):
                     "least 3 (or a vertices_file)"
                 )
             lo, hi = b.centres_extent() if b.shape == "points" else b.extent()
-            if lo[0] < -eps or lo[1] < -eps or hi[0] > W + eps or hi[1] > Hh + eps:
+            if any(a < -eps or c > s + eps for a, c, s in zip(lo, hi, sides, strict=False)):
+                span = ", ".join(f"{n} {a}..{c}" for n, a, c in zip("xyz", lo, hi, strict=False))
                 raise CaseError(
-                    f"{key}: extent x {lo[0]}..{hi[0]}, y {lo[1]}..{hi[1]} um lies outside the "
-                    f"domain 0..{W} x 0..{Hh} um"
+                    f"{key}: extent {span} um lies outside the domain "
+                    f"{' x '.join(f'0..{s}' for s in sides)} um"
                 )
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
@@ -320,6 +325,11 @@ class Case(Model):
             )
         return self
 
+    def domain_um(self) -> tuple[float, ...]:
+        """The domain's sides (um): width, height[, depth in 3D]."""
+        d = self.domain
+        return (d.width_um, d.height_um) + ((d.depth(),) if d.dim == 3 else ())
+
     def implicit_mechanics(self) -> bool:
         """Whether the mechanics steps implicitly (``time.integrator``; without mechanics there
         is nothing to step)."""
@@ -355,6 +365,13 @@ class Case(Model):
     def perimeter_um(self) -> float:
         """Total outline length of the bodies as seeded (um)."""
         return sum(b.perimeter_um() for b in self.bodies)
+
+    def outline_um(self) -> float:
+        """The bodies' outline as seeded: their perimeter (um, per unit depth) in 2D, their
+        surface (um^2) in 3D, whose bodies are spheres and boxes."""
+        if self.domain.dim == 2:
+            return self.perimeter_um()
+        return sum(b.area_um2() for b in self.bodies)
 
     def top_um(self) -> float:
         """The highest point of any body (um): the top of the powder."""

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import AfterValidator, Field
 
-from .model import Model, Pair
+from .model import Model, Point
 
 
 class CaseInfo(Model):
@@ -37,9 +37,30 @@ class Grid(Model):
     )
 
 
+def _two_or_three_dims(v: int) -> int:
+    if v not in (2, 3):
+        raise ValueError("allowed values are 2, 3")
+    return v
+
+
 class Domain(Model):
+    dim: Annotated[int, AfterValidator(_two_or_three_dims)] = Field(
+        2,
+        description="2: a plane section, every extensive output per unit depth (energies in "
+        "J/m, the _J_per_m columns); 3: a box width x height x depth, the same outputs in J "
+        "(the column names keep _J_per_m); y is up in both. 3D (issue #39) runs the explicit "
+        "mechanics and heat of spheres ([[bodies]] discs with [x, y, z] centres) and boxes; "
+        "what it lacks is refused by its key (docs/limitations.md)",
+    )
     width_um: float = Field(80.0, gt=0, description="domain width (um); x from 0")
     height_um: float = Field(48.0, gt=0, description="domain height (um); y from 0 (baseplate)")
+    depth_um: float | None = Field(
+        None, gt=0, description="3D only: domain depth (um); z from 0; default the width"
+    )
+
+    def depth(self) -> float:
+        """The z extent in 3D (um): depth_um, or the width without one."""
+        return self.width_um if self.depth_um is None else self.depth_um
 
 
 class Wall(Model):
@@ -52,16 +73,20 @@ class Wall(Model):
 
 class Boundary(Model):
     """Bottom wall default: `thermal = "fixed"` at 140 C; top wall default:
-    `mechanical = "open"`."""
+    `mechanical = "open"`. `front` (z = 0) and `back` (z = depth): 3D only, defaults slip and
+    insulated."""
 
     left: Wall = Field(default_factory=Wall)
     right: Wall = Field(default_factory=Wall)
     bottom: Wall = Field(default_factory=lambda: Wall(thermal="fixed"))
     top: Wall = Field(default_factory=lambda: Wall(mechanical="open"))
+    front: Wall = Field(default_factory=Wall, description="3D only: the wall at z = 0")
+    back: Wall = Field(default_factory=Wall, description="3D only: the wall at z = depth")
 
-    def walls(self) -> tuple[Wall, Wall, Wall, Wall]:
-        """(left, right, bottom, top): the order of the solver's wall codes."""
-        return self.left, self.right, self.bottom, self.top
+    def walls(self, dim: int = 2) -> tuple[Wall, ...]:
+        """(left, right, bottom, top[, front, back]): the order of the solver's wall codes."""
+        six = self.left, self.right, self.bottom, self.top, self.front, self.back
+        return six[: 2 * dim]
 
 
 class Physics(Model):
@@ -72,7 +97,10 @@ class Physics(Model):
     thermal_strain: bool = Field(
         True, description="thermal and transformation strains (eqs. 36-37)"
     )
-    gravity_m_s2: Pair = Field([0.0, -9.81], description="body force per mass")
+    gravity_m_s2: Point = Field(
+        [0.0, -9.81],
+        description="body force per mass; [gx, gy] (in 3D gz = 0) or [gx, gy, gz] in 3D; y is up",
+    )
 
 
 class Fusion(Model):
@@ -171,7 +199,8 @@ class Thermal(Model):
         1.0,
         ge=0,
         description="rate of the sub-grid temperature filter, in units of 1 / the thermal "
-        "stability limit h^2 rho c / 4k: each heat step removes 1 - exp(-rate dt_heat / limit) "
+        "stability limit h^2 rho c / 4k, in 3D too (its own limit is 2/3 of that): each heat "
+        "step removes 1 - exp(-rate dt_heat / limit) "
         "of the points' sub-grid temperature noise (energy-conserving; physics/thermal.py). "
         "Increments alone never damp it, and stirred by the flow it grew to 6 K below the plate "
         "over 30 ms; rates of 3 and more overshoot at a sharp front; 0: increments alone (FLIP)",

@@ -103,6 +103,9 @@ class OutputWriter:
         ``deform`` is the drawn deformation (``deformation``); ``point_data`` the VTU's further
         fields (:func:`taichi_sls.io.vtu.point_data`). Without it the VTU carries ``deform``
         under the name of what it is."""
+        if not (self.png or self.vtu):  # nothing to draw (a 3D run: frames not built yet)
+            self.frames_written += 1
+            return
         x = np.asarray(x_um, dtype=float).reshape(-1, 2)
         fields = {
             "T_C": np.asarray(T_C, dtype=float).ravel(),

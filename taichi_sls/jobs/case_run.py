@@ -118,7 +118,7 @@ def run_case(
     horizon = case.time.max_s if solidify else schedule[-1] * sim.dt
     print(
         f"{case.case.name}: {sc.n_points} points, {sc.table1_nodes} nodes "
-        f"(domain + ghost layer; {sc.nx * sc.ny} in the arrays), dt = {sim.dt:.3g} s, "
+        f"(domain + ghost layer; {sc.nx * sc.ny * sc.nz} in the arrays), dt = {sim.dt:.3g} s, "
         + (
             f"until solidified (at most {case.time.max_s:g} s, {schedule[-1]} steps)"
             if solidify
@@ -132,7 +132,7 @@ def run_case(
         "status": "running",
         "points": sc.n_points,
         "nodes": sc.table1_nodes,
-        "nodes_in_arrays": sc.nx * sc.ny,
+        "nodes_in_arrays": sc.nx * sc.ny * sc.nz,
         "dt_s": sim.dt,
         "dt_limits_s": sim.dt_limits,
         "mass_scale": case.solver.mass_scale,
@@ -198,7 +198,7 @@ def run_case(
         baseline_um = summary["settle"]["neck_um"]
     summary["initial"] = first
     last, before = first, deque(maxlen=SETTLED_FRAMES)  # the frames before last
-    walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
+    walls = [w.temperature_C for w in case.boundary.walls(case.domain.dim) if w.thermal == "fixed"]
     bar = Progress(
         horizon,
         sim.t,
@@ -309,7 +309,8 @@ def run_case(
         writer.summary(summary)
         writer.finish(beam_off(case) if bed is not None else None)
         try:
-            if bed is None:  # a bed's outcome.png is drawn with its contacts above
+            # a bed's outcome.png is drawn with its contacts above; a 3D run's is not built
+            if bed is None and case.domain.dim == 2:
                 plot_outcome(out_dir, sc.x, sim.point_arrays()["x"], sc.body)
         except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
             print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)

@@ -36,9 +36,10 @@ def to3(A, dim: ti.template()):
 
 @ti.func
 def embed3(e2):
-    """In-plane 2x2 strain -> 3x3 with eps_zz = 0 (plane strain)."""
+    """A dim x dim strain as 3x3: in 2D the in-plane strain with eps_zz = 0 (plane strain), in
+    3D itself."""
     e = ti.Matrix(ZERO_MATRIX[3, 3])
-    for a, b in ti.static(ti.ndrange(2, 2)):
+    for a, b in ti.static(ti.ndrange(e2.n, e2.m)):
         e[a, b] = e2[a, b]
     return e
 
@@ -314,7 +315,7 @@ def stress_update(cfg: ti.template(), pt: ti.template(), mat: ti.template(), p, 
     (:func:`hencky_update`) or small (:func:`small_strain_update`); with a solvent viscosity
     also its stress (force only)."""
     if ti.static(cfg.strain == Strain.FINITE):
-        I3 = ti.Matrix(IDENTITY[3])  # f_zz = 1: plane strain
+        I3 = ti.Matrix(IDENTITY[3])  # 2D: f_zz = 1, plane strain
         sig, Fe, dgam, n = _finite_step(cfg, pt, mat, p, I3 + dt * to3(L, cfg.dim), pt.J[p], dt)
         pt.stress[p] = sig
         pt.elastic_stretch[p] = Fe

@@ -11,10 +11,14 @@ def node_x(cfg: ti.template(), idx):
 
 @ti.func
 def active(box: ti.template(), shrink: ti.template() = 0):
-    """Index ranges of the active region ``box`` = [i0, j0, i1, j1) for ti.ndrange; ``shrink``
-    drops that many nodes at the upper end (1: the cells between active nodes)."""
+    """Index ranges of the active region ``box`` = [i0, j0, i1, j1) (3D: [i0, j0, k0, i1, j1,
+    k1)) for ti.ndrange; ``shrink`` drops that many nodes at the upper end (1: the cells between
+    active nodes)."""
     b = box[None]
-    return (b[0], b[2] - shrink), (b[1], b[3] - shrink)
+    if ti.static(box.n == 6):
+        return (b[0], b[3] - shrink), (b[1], b[4] - shrink), (b[2], b[5] - shrink)
+    else:
+        return (b[0], b[2] - shrink), (b[1], b[3] - shrink)
 
 
 @ti.func

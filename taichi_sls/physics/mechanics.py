@@ -60,7 +60,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         if ti.static(cfg.solvent):
             sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
     g = ti.Vector(cfg.gravity, dt=float)
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         I = base + o
         mv = vp
@@ -78,10 +78,11 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
 
 @ti.func
 def apply_walls(cfg: ti.template(), I, v):
-    """Rigid walls on the node lines x = 0, x = W, y = 0, y = H and beyond (ghost nodes)."""
+    """Rigid walls on the node lines x = 0, x = W, y = 0, y = H (3D: z = 0, z = D) and beyond
+    (ghost nodes)."""
     lo = cfg.off
-    hi = ti.Vector([cfg.off + cfg.ncx, cfg.off + cfg.ncy])
-    for d in ti.static(range(2)):
+    hi = ti.Vector(cfg.wall_index)
+    for d in ti.static(range(cfg.dim)):
         kind_lo = ti.static(cfg.wall_mechanical[2 * d])
         kind_hi = ti.static(cfg.wall_mechanical[2 * d + 1])
         if I[d] <= lo:
@@ -117,7 +118,7 @@ def g2p_velocity(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
     v_pic = ti.Vector(ZERO_VECTOR[cfg.dim])
     dv = ti.Vector(ZERO_VECTOR[cfg.dim])
     B = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         I = base + o
         vi = nd.v[I]
@@ -149,7 +150,7 @@ def interpolate_velocity(cfg: ti.template(), nd: ti.template(), base, w, dw):
     """The grid velocity at a point and its gradient L = sum_i v_i grad N_i (eq. 16)."""
     v_grid = ti.Vector(ZERO_VECTOR[cfg.dim])
     L = ti.Matrix(ZERO_MATRIX[cfg.dim, cfg.dim])
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         vi = nd.v[base + o]
         v_grid += N * vi
@@ -176,7 +177,7 @@ def p2g_momentum(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, ba
     """MUSL: the updated point momenta back to the grid (affine part included for APIC)."""
     xp = pt.x[p]
     mp = inertia(cfg, pt.mass[p])
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         I = base + o
         mv = pt.v[p]

@@ -9,13 +9,11 @@ from taichi_sls.backend import ti
 
 from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
 
-# Spatial dimension. The transfers are written for any DIM through ti.static loops; the scene,
-# surface tension and output are 2D (plane strain) for now.
-DIM = 2
-# The 3^DIM node offsets of the stencil. Loops over them run at run time,
-# `for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE))`: a `ti.static` loop would make the front end
-# build its body 3^DIM times at every call site (docs/compile.md).
-STENCIL_SHAPE = (3,) * DIM
+# The node offsets of a point's stencil, 3 per axis, by dimension (``domain.dim``, 2 or 3). Loops
+# over them run at run time, `for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim]))`: a
+# `ti.static` loop would make the front end build its body 3^dim times at every call site
+# (docs/compile.md).
+STENCIL_SHAPE = {dim: (3,) * dim for dim in (2, 3)}
 
 
 @ti.func

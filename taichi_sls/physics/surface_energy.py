@@ -58,7 +58,7 @@ GAUSS = {
 def scatter_volume(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
     """Volume colour: V_p N_i(x_p) onto the 3x3 nodes of point p (in the P2G loop)."""
     Vp = pt.volume0[p] * pt.J[p]
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         scatter_add(cfg, nd.volume, base + o, N * Vp)
 
@@ -101,7 +101,7 @@ def segment_force(cfg: ti.template(), nd: ti.template(), a, b, gamma):
         for q in ti.static(range(len(s))):
             xq = a + s[q] * d
             base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
-            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
                 N, gN = node_weight(w, dw, o)
                 I = base + o
                 tg = t.dot(gN)

@@ -113,7 +113,7 @@ def p2g_heat_capacity(
 ):
     mp = pt.mass[p]
     c = point_heat_capacity(cfg, mat[pt.material[p]], pt.T[p], pt.solid_fraction[p])
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         I = base + o
         scatter_add(cfg, nd.heat_capacity, I, N * mp * c)
@@ -125,8 +125,8 @@ def fixed_temperature(cfg: ti.template(), I):
     """(is fixed, wall temperature) of node I from the walls' thermal conditions."""
     fixed = 0
     Tw = 0.0
-    hi = ti.Vector([cfg.off + cfg.ncx, cfg.off + cfg.ncy])
-    for d in ti.static(range(2)):
+    hi = ti.Vector(cfg.wall_index)
+    for d in ti.static(range(cfg.dim)):
         if ti.static(cfg.wall_fixed[2 * d]):
             if I[d] <= cfg.off:
                 fixed = 1
@@ -169,7 +169,7 @@ def p2g_heat_flux(
     gT = ti.Vector(ZERO_VECTOR[cfg.dim])
     T_grid = 0.0
     w_fixed = 0.0
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         gT += nd.T[base + o] * gN
         if ti.static(cfg.subgrid_filter > 0.0):
@@ -183,7 +183,7 @@ def p2g_heat_flux(
         if w_fixed == 0.0:  # points beside a fixed wall take the grid temperature anyway
             mc = pt.mass[p] * point_heat_capacity(cfg, mp, pt.T[p], pt.solid_fraction[p])
             d = pt.T[p] - T_grid
-            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
                 N, gN = node_weight(w, dw, o)
                 scatter_add(cfg, nd.deviation, base + o, N * mc * d)
                 scatter_add(cfg, nd.deviation_capacity, base + o, N * mc)
@@ -194,7 +194,7 @@ def p2g_heat_flux(
     if ti.static(cfg.laser):
         s = laser_source(lasers, cfg.n_lasers, pt.x[p], t, dt)
         energy = Vp * s * dt
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         scatter_add(cfg, nd.heat_rate, base + o, -Vp * k * gT.dot(gN) + Vp * s * N)
     return energy
@@ -297,7 +297,7 @@ def g2p_heat(
     w_fixed = 0.0
     T_grid = 0.0  # the grid temperature at the point, before the increment
     d_smooth = 0.0  # the smooth part of the points' deviation from it
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
         I = base + o
         dTg += N * nd.dT[I]

@@ -190,9 +190,7 @@ class State:
         self.points = struct_type(POINT_MEMBERS, cfg.dim).field(
             shape=scene.n_points, layout=ti.Layout.SOA
         )
-        self.nodes = struct_type(NODE_MEMBERS, cfg.dim).field(
-            shape=(cfg.nx, cfg.ny), layout=ti.Layout.SOA
-        )
+        self.nodes = struct_type(NODE_MEMBERS, cfg.dim).field(shape=cfg.shape, layout=ti.Layout.SOA)
         struct_copy.copies_among(self.nodes, NODE_COPIES)
         self.scalars = ti.types.struct(
             t=float,
@@ -208,7 +206,8 @@ class State:
         self.materials = material_struct().field(shape=n_mat, layout=ti.Layout.SOA)
         self.lasers = laser_struct().field(shape=max(cfg.n_lasers, 1), layout=ti.Layout.SOA)
         self.surf = SurfaceScratch(cfg.nx, cfg.ny)
-        self.box = ti.Vector.field(4, ti.i32, ())  # active region [i0, j0, i1, j1)
+        # active region [i0, j0, i1, j1) ([i0, j0, k0, i1, j1, k1) in 3D): lower corner, upper
+        self.box = ti.Vector.field(2 * cfg.dim, ti.i32, ())
         self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())
         self.implicit = ImplicitFields(cfg) if cfg.implicit else None
         structs = [self.points, self.nodes, self.scalars, self.materials, self.lasers, self.totals]
@@ -231,10 +230,10 @@ class State:
         struct_copy.from_numpy(pt, seeded)
         self.surf.fit[None] = fit_matrix()
         # outside the active region the grid keeps these: empty, and outside every body
-        cap = np.full((cfg.nx, cfg.ny), cfg.phi_cap)
+        cap = np.full(cfg.shape, cfg.phi_cap)
         struct_copy.from_numpy(self.nodes, {"phi_raw": cap, "phi": cap, "phi_smooth": cap})
-        full = [0, 0, cfg.nx, cfg.ny]
-        self.box[None] = [cfg.nx, cfg.ny, 0, 0] if cfg.active_region else full
+        full = [0] * cfg.dim + list(cfg.shape)
+        self.box[None] = list(cfg.shape) + [0] * cfg.dim if cfg.active_region else full
         if cfg.n_lasers:
             struct_copy.from_numpy(self.lasers, lasers)
         self.scalars.t[None] = 0.0
@@ -292,5 +291,6 @@ class State:
             mp, embed3(eps), z, 0.0, 0.0, xi, pt.T[p], 1.0, False, self.cfg.stress_reading
         )[0]
 
-    def node_position(self, i: int, j: int) -> tuple[float, float]:
-        return ((i - self.cfg.off) * self.cfg.h, (j - self.cfg.off) * self.cfg.h)
+    def node_position(self, *idx: int) -> tuple[float, ...]:
+        """The position (m) of the node with array indices ``idx`` (one per axis)."""
+        return tuple((i - self.cfg.off) * self.cfg.h for i in idx)

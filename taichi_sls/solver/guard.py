@@ -45,7 +45,8 @@ class Guard:
         i = int(np.argmax(bad))
         x = self.state.points.x.to_numpy()[i] * 1e6
         body = int(self.state.scene.body[i])
-        return f"point {i} (body {body}) at x = {x[0]:.6g}, y = {x[1]:.6g} um"
+        z = f", z = {x[2]:.6g}" if len(x) == 3 else ""
+        return f"point {i} (body {body}) at x = {x[0]:.6g}, y = {x[1]:.6g}{z} um"
 
     def check(
         self,
@@ -76,9 +77,9 @@ class Guard:
             )
         elif internal["trouble"] == Trouble.LEFT_GRID:
             # how far each point lies beyond the grid's reach
-            lo, hi_x, hi_y = grid_reach(st.cfg)
+            lo, hi = grid_reach(st.cfg)
             x = pt.x.to_numpy()
-            r = np.maximum(lo - x, x - np.array([hi_x, hi_y])).max(axis=1)
+            r = np.maximum(lo - x, x - np.array(hi)).max(axis=1)
             problem = (f"a point left the grid: {self._where(r)}", hint)
         elif mon["J_min"] <= 0.0:
             problem = (

@@ -142,7 +142,7 @@ def _point_force(st: ti.template(), p):
     v_grid, L = interpolate_velocity(st.cfg, st.nodes, base, w, dw)
     sig, mu_t, K, eta = trial_stress(st.cfg, pt, st.materials, p, L, dt)
     V = pt.volume0[p] * pt.J[p]
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE)):
+    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[st.cfg.dim])):
         N, gN = node_weight(w, dw, o)
         st.implicit.internal[base + o] += -V * (sig @ gN)
     a_lam = dt * (K - 2.0 * mu_t / 3.0) - 2.0 * eta / 3.0

@@ -59,7 +59,7 @@ def point_base(cfg: ti.template(), pt: ti.template(), p):  # point_stencil's bas
 def _clamped(cfg: ti.template(), base):
     # A point that has left the grid (or become NaN) must not write outside the arrays: the
     # guard reports it at the next frame; the 2-cell padding keeps a healthy run far from this.
-    return ti.max(ti.min(base, ti.Vector([cfg.nx - 4, cfg.ny - 4])), 1)
+    return ti.max(ti.min(base, ti.Vector([n - 4 for n in cfg.shape])), 1)
 
 
 @ti.func
@@ -136,16 +136,16 @@ def grow_box(st: ti.template(), blk, p):
     point has moved (the end of G2P), so that the next step's grid loops cover it."""
     if ti.static(st.cfg.active_region):
         m = ti.static(st.cfg.box_margin)
+        dim = ti.static(st.cfg.dim)
         base = ti.cast(ti.floor(st.points.x[p] * st.cfg.inv_h + 0.5), ti.i32) - 1 + st.cfg.off
-        lo = ti.Vector([ti.max(base[0] - 1 - m, 0), ti.max(base[1] - 1 - m, 0)])
-        hi = ti.Vector([ti.min(base[0] + 4 + m, st.cfg.nx), ti.min(base[1] + 4 + m, st.cfg.ny)])
+        lo = ti.max(base - 1 - m, 0)
+        hi = ti.min(base + 4 + m, ti.Vector(st.cfg.shape))
         if ti.static(blocks(st)):
             st.blocks.box[blk] = widen(st.blocks.box[blk], lo, hi)
         else:
-            ti.atomic_min(st.box[None][0], lo[0])
-            ti.atomic_min(st.box[None][1], lo[1])
-            ti.atomic_max(st.box[None][2], hi[0])
-            ti.atomic_max(st.box[None][3], hi[1])
+            for d in ti.static(range(dim)):
+                ti.atomic_min(st.box[None][d], lo[d])
+                ti.atomic_max(st.box[None][dim + d], hi[d])
 
 
 @ti.func
@@ -179,12 +179,13 @@ def reduce_blocks(st: ti.template()):
 
 @ti.func
 def box_empty(st: ti.template()):
-    return ti.Vector([st.cfg.nx, st.cfg.ny, 0, 0])
+    """The box that holds nothing: its lower corner at the arrays' far end, its upper at 0."""
+    return ti.Vector(ti.static(list(st.cfg.shape) + [0] * st.cfg.dim))
 
 
 @ti.func
 def widen(box, lo, hi):
-    """The box [i0, j0, i1, j1) grown to hold [lo, hi)."""
+    """The box [i0, j0, i1, j1) grown to hold [lo, hi) (the blocks layout, 2D)."""
     return ti.Vector(
         [ti.min(box[0], lo[0]), ti.min(box[1], lo[1]), ti.max(box[2], hi[0]), ti.max(box[3], hi[1])]
     )

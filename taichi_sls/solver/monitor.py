@@ -32,14 +32,10 @@ class Trouble(IntEnum):
     LEFT_GRID = 2  # a point beyond the ghost layer
 
 
-def grid_reach(cfg) -> tuple[float, float, float]:
-    """(lowest x and y, highest x, highest y) in m that a point may reach with its stencil
+def grid_reach(cfg) -> tuple[float, tuple[float, ...]]:
+    """(lowest coordinate, highest per axis) in m that a point may reach with its stencil
     inside the arrays; beyond them it has left the grid (Trouble.LEFT_GRID)."""
-    return (
-        -float(cfg.off - 1) * cfg.h,
-        float(cfg.nx - cfg.off - 2) * cfg.h,
-        float(cfg.ny - cfg.off - 2) * cfg.h,
-    )
+    return -float(cfg.off - 1) * cfg.h, tuple(float(n - cfg.off - 2) * cfg.h for n in cfg.shape)
 
 
 @ti.kernel
@@ -57,7 +53,7 @@ def reduce_points(st: ti.template()):
     tot.enthalpy[None] = 0.0
     tot.kinetic_energy[None] = 0.0
     tot.trouble[None] = 0.0
-    lo, hi_x, hi_y = ti.static(grid_reach(st.cfg))
+    lo, hi = ti.static(grid_reach(st.cfg))
     # serial: float sums in a fixed order, so that monitors repeat bit for bit (resume test);
     # it runs once per output frame
     ti.loop_config(serialize=True)
@@ -76,9 +72,9 @@ def reduce_points(st: ti.template()):
         ti.atomic_max(tot.v_max[None], pt.v[p].norm())
         x = pt.x[p]
         bad = float(Trouble.NONE)
-        if not (x[0] == x[0] and x[1] == x[1] and T == T and pt.J[p] == pt.J[p]):
+        if not ((x == x).all() and T == T and pt.J[p] == pt.J[p]):
             bad = float(Trouble.NAN)
-        elif x[0] < lo or x[1] < lo or x[0] > hi_x or x[1] > hi_y:
+        elif (x < lo).any() or (x > ti.Vector(hi)).any():
             bad = float(Trouble.LEFT_GRID)
         ti.atomic_max(tot.trouble[None], bad)
 

@@ -108,14 +108,22 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
 
 # ----------------------------------------------------------------------------- stability
 
-# c of the solvent viscosity's explicit limit dt <= rho h^2 / (c eta_s) in two dimensions. The
-# stress 2 eta_s dev(D) (3D deviator, plane strain) gives the momentum equation
-# eta_s (lap v + grad div v / 3); on a lumped-mass grid of spacing h the discrete Laplacian's
-# largest eigenvalue is 4 d / h^2 (d = 2; the uGIMP weights only smooth it) and the grad-div
-# part adds at most a third, so nu lambda_max <= (4/3) 4 d nu / h^2, nu = eta_s / rho; forward
-# Euler in the velocity is stable for dt lambda_max <= 2: c = 8 d / 3. It is taken beside the
-# elastic limit, not combined with it: time.safety (0.4) covers the two acting together.
-VISCOUS_STENCIL = 8.0 * 2 / 3.0
+
+# c of the solvent viscosity's explicit limit dt <= rho h^2 / (c eta_s) in d dimensions. The
+# stress 2 eta_s dev(D) (3D deviator) gives the momentum equation eta_s (lap v + grad div v / 3);
+# on a lumped-mass grid of spacing h the discrete Laplacian's largest eigenvalue is 4 d / h^2
+# (the uGIMP weights only smooth it) and the grad-div part adds at most a third, so
+# nu lambda_max <= (4/3) 4 d nu / h^2, nu = eta_s / rho; forward Euler in the velocity is stable
+# for dt lambda_max <= 2: c = 8 d / 3. It is taken beside the elastic limit, not combined with
+# it: time.safety (0.4) covers the two acting together. The same eigenvalue 4 d / h^2 sets the
+# thermal limit h^2 rho c / (2 d k) (eq. 48's h^2 / 4 alpha in 2D) and scales the elastic one,
+# written h / c_p in 2D, by sqrt(2 / d).
+def viscous_stencil(dim: int = 2) -> float:
+    """c = 8 d / 3 of the viscous limit rho h^2 / (c eta_s) in ``dim`` dimensions."""
+    return 8.0 * dim / 3.0
+
+
+VISCOUS_STENCIL = viscous_stencil(2)
 
 
 def p_wave_modulus(E: float, nu: float) -> float:
@@ -123,12 +131,13 @@ def p_wave_modulus(E: float, nu: float) -> float:
     return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
 
-def stability_limits(m: Material, h: float) -> dict[str, float]:
+def stability_limits(m: Material, h: float, dim: int = 2) -> dict[str, float]:
     """Time-step limits (s) of one material on grid spacing h (m), docs/model.md / eqs. 46-48.
 
     The elastic limit uses the larger P-wave modulus of the two phases, each with its own nu;
     the thermal limit the smallest heat capacity and largest conductivity; a solvent
-    viscosity adds its own ("viscous", :data:`VISCOUS_STENCIL`).
+    viscosity adds its own ("viscous", :func:`viscous_stencil`). ``dim``: 2 or 3 (the grid
+    stencil's largest eigenvalue grows with it).
     """
     M = max(
         p_wave_modulus(m.youngs_solid_Pa, m.poisson),
@@ -137,9 +146,11 @@ def stability_limits(m: Material, h: float) -> dict[str, float]:
     c_wave = math.sqrt(M / m.density_kg_m3)
     k = max(m.conductivity_solid_W_mK, m.conductivity_liquid_W_mK)
     c = min(m.heat_capacity_solid_J_kgK, m.heat_capacity_liquid_J_kgK)
-    out = {"elastic": h / c_wave, "thermal": h * h * m.density_kg_m3 * c / (4 * k)}
+    # sqrt(2 / 2) and 2 * 2 are exact: the 2D limits keep their bits
+    elastic = h / c_wave * math.sqrt(2 / dim)
+    out = {"elastic": elastic, "thermal": h * h * m.density_kg_m3 * c / (2 * dim * k)}
     if m.solvent_viscosity_Pa_s > 0:
-        out["viscous"] = h * h * m.density_kg_m3 / (VISCOUS_STENCIL * m.solvent_viscosity_Pa_s)
+        out["viscous"] = h * h * m.density_kg_m3 / (viscous_stencil(dim) * m.solvent_viscosity_Pa_s)
     if m.surface_tension_N_m > 0:
         out["surface_tension"] = math.sqrt(m.density_kg_m3 * h**3 / m.surface_tension_N_m)
     return out

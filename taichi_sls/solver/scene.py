@@ -28,18 +28,20 @@ class Scene:
     off: int  # array index of the node at x = 0 (and y = 0)
     width: float  # domain (m)
     height: float
-    x: np.ndarray  # (N, 2) point positions (m)
-    vol: np.ndarray  # (N,) point volumes (m^2 per unit depth)
+    x: np.ndarray  # (N, dim) point positions (m)
+    vol: np.ndarray  # (N,) point volumes (m^2 per unit depth in 2D, m^3 in 3D)
     body: np.ndarray  # (N,) body index
     material: np.ndarray  # (N,) material index
     T0_C: np.ndarray  # (N,) initial temperature (C)
-    v0: np.ndarray  # (N, 2) initial velocity (m/s)
+    v0: np.ndarray  # (N, dim) initial velocity (m/s)
     p0: np.ndarray  # (N,) initial in-plane pressure (Pa): surface_tension.initial_stress
     material_names: list[str]
     table1_nodes: int  # nodes of domain plus ghost layer (what the paper's Table 1 counts)
     # a previous layer's points: which carry their state, and the members' values (N, ...)
     carried: np.ndarray | None = None
     carried_state: dict[str, np.ndarray] | None = None
+    nz: int = 1  # nodes along z in the arrays (3D)
+    depth: float = 0.0  # domain depth (m; 3D)
 
     @property
     def n_points(self) -> int:
@@ -81,6 +83,19 @@ def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
         return inside_polygon(np.asarray(body.outline_um(), dtype=float), px, py)
     (x0, y0), (x1, y1) = body.min_um, body.max_um
     return (px > x0) & (px < x1) & (py > y0) & (py < y1)
+
+
+def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
+    """The body whose inside holds each candidate point (N, 3) (-1: none), the first that
+    does: a sphere (a disc with a 3D centre) or a box (a rect with 3D corners)."""
+    owner = np.full(len(P), -1, dtype=np.int64)
+    for bi, b in enumerate(case.bodies):
+        if b.shape == "disc":
+            inside = ((P - np.asarray(b.center_um)) ** 2).sum(axis=1) < b.radius_um**2
+        else:
+            inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
+        owner[(owner == -1) & inside] = bi
+    return owner
 
 
 def _owners(case: Case, px: np.ndarray, py: np.ndarray, spacing: float) -> np.ndarray:
@@ -158,24 +173,28 @@ def laplace_pressure(case: Case, body) -> float:
 
 
 def build_scene(case: Case) -> Scene:
-    """Seed the points of every body (a point belongs to the first body that holds it)."""
+    """Seed the points of every body (a point belongs to the first body that holds it): n per
+    cell along each of the case's ``domain.dim`` axes."""
+    dim = case.domain.dim
     h_um = case.grid.spacing_um
-    W, H = case.domain.width_um, case.domain.height_um
-    ncx = int(round(W / h_um))
-    ncy = int(round(H / h_um))
+    sides = case.domain_um()
+    cells = [int(round(s / h_um)) for s in sides]
+    ncx, ncy = cells[:2]
     n = case.grid.points_per_cell
     sub = (np.arange(n) + 0.5) / n  # 2 per cell -> 1/4, 3/4: the quarter points
-    gx = ((np.arange(ncx)[:, None] + sub[None, :]) * h_um).ravel()
-    gy = ((np.arange(ncy)[:, None] + sub[None, :]) * h_um).ravel()
-    PX, PY = np.meshgrid(gx, gy, indexing="ij")
-    PX, PY = PX.ravel(), PY.ravel()
+    axes = [((np.arange(c)[:, None] + sub[None, :]) * h_um).ravel() for c in cells]
+    P = [a.ravel() for a in np.meshgrid(*axes, indexing="ij")]
     names = list(case.materials)
     xs, bodies, mats, temps, vels, pres, fills = [], [], [], [], [], [], []
     carried: list[tuple[int, dict[str, np.ndarray]]] = []  # (first point, members)
-    owner, fill = _seed(case, PX, PY, h_um / n)
+    if dim == 2:
+        owner, fill = _seed(case, *P, h_um / n)
+    else:  # centre seeding (config/dim.py refuses area seeding in 3D)
+        owner = _owners_3d(case, np.stack(P, axis=1))
+        fill = np.ones(len(owner))
     for bi, b in enumerate(case.bodies):
         sel = owner == bi
-        xy, f = np.stack([PX[sel], PY[sel]], axis=1), fill[sel]
+        xy, f = np.stack([c[sel] for c in P], axis=1), fill[sel]
         if b.shape == "points":  # a previous layer's body: its points, and its fillets' seeded
             placed, vol = b.points_um()
             state = b.carried_state()
@@ -196,31 +215,36 @@ def build_scene(case: Case) -> Scene:
         mats.append(np.full(k, names.index(b.material), dtype=np.int32))
         T = case.thermal.initial_C if b.temperature_C is None else b.temperature_C
         temps.append(np.full(k, T))
-        vels.append(np.tile(np.asarray(b.velocity_m_s, dtype=float), (k, 1)))
+        v = [*b.velocity_m_s, *(0.0,) * (dim - len(b.velocity_m_s))]  # vz = 0 if left out
+        vels.append(np.tile(np.asarray(v, dtype=float), (k, 1)))
         pres.append(np.full(k, laplace_pressure(case, b)))
     x = np.concatenate(xs) * 1e-6
     mask, state = _carried(carried, len(x))
     g = case.grid.ghost_cells
     off = g + PAD
     h = h_um * 1e-6
+    z = {}
+    if dim == 3:  # ghost cells beyond the front and back walls as beyond the left and right
+        z = {"nz": cells[2] + 1 + 2 * off, "depth": sides[2] * 1e-6}
     return Scene(
         h=h,
         nx=ncx + 1 + 2 * off,
         ny=ncy + 1 + 2 * off,
         off=off,
-        width=W * 1e-6,
-        height=H * 1e-6,
+        width=sides[0] * 1e-6,
+        height=sides[1] * 1e-6,
         x=x,
-        vol=np.concatenate(fills) * (h / n) ** 2,
+        vol=np.concatenate(fills) * (h / n) ** dim,
         body=np.concatenate(bodies),
         material=np.concatenate(mats),
         T0_C=np.concatenate(temps),
         v0=np.concatenate(vels),
         p0=np.concatenate(pres),
         material_names=names,
-        table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g),
+        table1_nodes=(ncx + 1 + 2 * g) * (ncy + 1 + g) * (cells[2] + 1 + 2 * g if dim == 3 else 1),
         carried=mask,
         carried_state=state,
+        **z,
     )
 
 

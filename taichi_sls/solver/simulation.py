@@ -151,7 +151,7 @@ class Simulation(NeckMeasures):
         # each point's index in the order the run started with: the blocks layout sorts the
         # points again as they flow, and a checkpoint keeps that order
         self.point_order = np.arange(self.scene.n_points)
-        walls = [w.temperature_C for w in case.boundary.walls() if w.thermal == "fixed"]
+        walls = [w.temperature_C for w in case.boundary.walls(cfg.dim) if w.thermal == "fixed"]
         coldest = min([float(self.scene.T0_C.min()), *walls])
         # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32
         self.guard = Guard(
@@ -161,11 +161,11 @@ class Simulation(NeckMeasures):
             T_floor_K=coldest + KELVIN if case.physics.thermal else -math.inf,
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
-        self._pair = len(case.bodies) >= 2
-        # the contacts, found once on the seeded points; each body's reach for the neck
-        # sections is its equivalent radius sqrt(area / pi)
+        two_d = case.domain.dim == 2  # neck sections are 2D (issue #39): 3D reports them NaN
+        self._pair = len(case.bodies) >= 2 and two_d
+        # the contacts, found once on the seeded points; each body's neck reach sqrt(area / pi)
         sc = self.scene
-        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell)
+        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell) if two_d else []
         area = np.bincount(sc.body, weights=sc.vol)
         self._body_radius = np.sqrt(area / np.pi)
         self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
@@ -332,9 +332,9 @@ class Simulation(NeckMeasures):
         return (net - rise) / (abs(self._H0) + mon["laser_energy_J_per_m"])
 
     def surface_energy(self) -> float:
-        """gamma times the bodies' perimeter as seeded (J/m): the scale of the kinetic ratio."""
+        """gamma times the bodies' outline as seeded (J/m; 3D: surface, J): kinetic ratio scale."""
         gamma = max(m.surface_tension_N_m for m in self.case.materials.values())
-        return max(gamma * self.case.perimeter_um() * 1e-6, 1e-30)
+        return max(gamma * self.case.outline_um() * 1e-6 ** (self.state.cfg.dim - 1), 1e-30)
 
     def energy_bound(self) -> float:
         """Every energy a run can turn into motion: initial kinetic energy, surface energy of the
@@ -342,11 +342,11 @@ class Simulation(NeckMeasures):
         if self._e_static is None:
             c = self.case
             gamma = max(m.surface_tension_N_m for m in c.materials.values())
-            g = math.hypot(*c.physics.gravity_m_s2)
-            M = float(self._mass.sum())
+            g, M = math.hypot(*c.physics.gravity_m_s2), float(self._mass.sum())
             v0 = self.point_arrays()["v"]
             ke0 = 0.5 * float((self._mass * (v0**2).sum(axis=1)).sum())
-            self._e_static = ke0 + gamma * c.perimeter_um() * 1e-6 + M * g * self.scene.height
+            surface = gamma * c.outline_um() * 1e-6 ** (c.domain.dim - 1)
+            self._e_static = ke0 + surface + M * g * self.scene.height
         return self._e_static + float(self.state.scalars.laser_energy[None])
 
     # ------------------------------------------------------------------ state

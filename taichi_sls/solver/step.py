@@ -279,7 +279,7 @@ def watch(st: ti.template(), p):
     if pt.J[p] <= 0.0:
         ti.atomic_min(sc.first_inverted[None], k)
     x = pt.x[p]
-    if not (x[0] == x[0] and x[1] == x[1] and pt.J[p] == pt.J[p]):
+    if not ((x == x).all() and pt.J[p] == pt.J[p]):
         ti.atomic_min(sc.first_nan[None], k)
 
 

@@ -25,7 +25,7 @@ def time_step_limits(case: Case) -> dict[str, float]:
     scale["viscous"] = s
     out: dict[str, float] = {}
     for m in case.materials.values():
-        for k, v in stability_limits(m, h).items():
+        for k, v in stability_limits(m, h, case.domain.dim).items():
             if keep.get(k, False):
                 out[k] = min(out.get(k, math.inf), v * scale[k])
     return out

@@ -111,7 +111,11 @@ def independent_checks(sim: Simulation, first: dict, last: dict) -> list[str]:
     if abs(net - rise) > 1e-6 * scale:
         bad.append(f"energy balance off by {(net - rise) / scale:.2e}")
     T = sim.state.points.T.to_numpy() - KELVIN
-    walls = [w.temperature_C for w in sim.case.boundary.walls() if w.thermal == "fixed"]
+    walls = [
+        w.temperature_C
+        for w in sim.case.boundary.walls(sim.case.domain.dim)
+        if w.thermal == "fixed"
+    ]
     floor = min([float(sim.scene.T0_C.min()), *walls])
     if T.min() < floor - 1.0:
         bad.append(f"T_min {T.min():.1f} C below {floor:.1f} C")

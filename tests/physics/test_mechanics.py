@@ -18,25 +18,28 @@ from taichi_sls.studies import verification as ver
 MODEL, PAPER = StressReading.MODEL, StressReading.PAPER
 
 
-def test_gimp_partition_of_unity_and_gradient_sum():
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gimp_partition_of_unity_and_gradient_sum(dim):
     init_taichi(optimize=False)
     n = 500
-    xs = ti.Vector.field(2, float, n)
-    out = ti.Vector.field(3, float, n)
+    xs = ti.Vector.field(dim, float, n)
+    out = ti.Vector.field(1 + dim, float, n)
 
     @ti.kernel
     def sums(h: float):
         for p in range(n):
             base, w, dw = stencil(xs[p], 1.0 / h, h, 0.25 * h, 4)
-            s = ti.Vector.zero(float, 3)
-            for o in ti.static(ti.grouped(ti.ndrange(*STENCIL_SHAPE))):
+            s = ti.Vector.zero(float, 1 + dim)
+            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[dim])):  # as the solver: at run time
                 N, g = node_weight(w, dw, o)
-                s += ti.Vector([N, g[0], g[1]])
+                s[0] += N
+                for d in ti.static(range(dim)):
+                    s[1 + d] += g[d]
             out[p] = s
 
     rng = np.random.default_rng(1)
     h = 2e-6
-    xs.from_numpy(rng.uniform(0, 10 * h, (n, 2)))
+    xs.from_numpy(rng.uniform(0, 10 * h, (n, dim)))
     sums(h)
     s = out.to_numpy()
     np.testing.assert_allclose(s[:, 0], 1.0, atol=1e-12)  # partition of unity

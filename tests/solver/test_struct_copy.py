@@ -32,10 +32,11 @@ def test_a_round_trip_matches_taichis_own_copies(shape):
         assert np.array_equal(back[k], v) and np.array_equal(v, arrays[k])
 
 
-@pytest.mark.parametrize("shape", [(), (5,), (3, 4)])
+@pytest.mark.parametrize("shape", [(), (5,), (3, 4), (2, 3, 4)])
 def test_vectors_matrices_and_a_subset_match_taichis_own_copies(shape):
-    """Vector and matrix members (the points' x, F, stress), node-shaped fields in C order, and
-    a subset of members (a checkpoint's), each equal to Taichi's member-by-member copy."""
+    """Vector and matrix members (the points' x, F, stress), node-shaped fields in C order (a
+    2D grid's and a 3D one's), and a subset of members (a checkpoint's), each equal to Taichi's
+    member-by-member copy."""
     kind = ti.types.struct(
         a=float, n=ti.i32, v=ti.types.vector(2, float), M=ti.types.matrix(2, 3, float)
     )
