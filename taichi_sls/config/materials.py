@@ -43,6 +43,12 @@ class Material(Model):
     """Every parameter of the paper's Table 3. `_solid` holds for T <= T_c, `_liquid` for
     T >= T_m; in between they are interpolated linearly in the solid fraction (eq. 33)."""
 
+    preset: str | None = Field(
+        None,
+        description="a bundled material whose values fill this table, the keys written beside "
+        "it overriding them (config/presets.py): pa12_process, PA12 as a machine runs it "
+        "(docs/pa12_process.md). Unset: the paper's Table 3, the defaults below",
+    )
     density_kg_m3: float = Field(1020.0, gt=0, description="rho")
     conductivity_solid_W_mK: float = Field(0.28, gt=0, description="k_c")
     conductivity_liquid_W_mK: float = Field(0.24, gt=0, description="k_m")
@@ -97,13 +103,24 @@ class Material(Model):
     yield_liquid_Pa: float = Field(1e4, ge=0, description="sigma_Y for T >= T_m")
     hardening_solid_Pa: float = Field(1e5, ge=0, description="H for T <= T_c")
     hardening_liquid_Pa: float = Field(0.0, ge=0, description="H for T >= T_m")
-    viscosity_model: Literal["exponential", "constant"] = Field(
+    viscosity_model: Literal["exponential", "constant", "arrhenius"] = Field(
         "exponential",
-        description="exponential: eta = A exp(-b T[C]) (Table 3); constant: eta = viscosity_Pas",
+        description="the Perzyna viscosity eta (eq. 41). exponential: eta = A exp(-b T[C]) "
+        "(Table 3); constant: eta = viscosity_Pas; arrhenius: a zero-shear law, the melt's "
+        "Newtonian viscosity eta_0 = viscosity_ref_Pas exp(E/R (1/T - 1/T_ref)) (T in K), "
+        "entered as eta = 2 eta_0 because the zero-yield Perzyna melt is Newtonian with "
+        "eta / 2 (docs/verification.md)",
     )
     viscosity_A_Pas: float = Field(130219.0, gt=0, description="A of the exponential law (Pa s)")
     viscosity_b_1_C: float = Field(0.02, ge=0, description="b of the exponential law (1/C)")
     viscosity_Pas: float = Field(1e3, gt=0, description="constant viscosity (Pa s)")
+    viscosity_ref_Pas: float = Field(
+        4175.0, gt=0, description="eta_ref of the arrhenius law: eta_0 at viscosity_ref_C (Pa s)"
+    )
+    viscosity_ref_C: float = Field(172.0, description="T_ref of the arrhenius law (C)")
+    viscosity_activation_J_mol: float = Field(
+        32.5e3, ge=0, description="E, the flow activation energy of the arrhenius law (J/mol)"
+    )
     surface_tension_N_m: float = Field(36.3e-3, ge=0, description="gamma (N/m)")
     solvent_viscosity_Pa_s: float = Field(
         0.0,

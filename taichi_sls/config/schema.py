@@ -23,6 +23,7 @@ from .materials import Material
 from .model import Model, Pair
 from .numerics import Solver, Time
 from .overlap import check_overlaps
+from .presets import expand_presets
 from .sections import (
     Boundary,
     CaseInfo,
@@ -68,7 +69,9 @@ class Case(Model):
     @model_validator(mode="before")
     @classmethod
     def _default_shape(cls, data: Any) -> Any:
-        """A body without ``shape`` is a disc (the discriminator needs the tag)."""
+        """A body without ``shape`` is a disc (the discriminator needs the tag); a material that
+        names a preset takes its values (config/presets.py)."""
+        data = expand_presets(data)
         if isinstance(data, dict) and "bodies" not in data and "bed" not in data:
             # the default [] is not validated: say here what --set bodies=[] says
             raise CaseError(f"bodies: missing; {NO_BODIES}")

@@ -31,6 +31,7 @@ class ViscosityModel(IntEnum):
 
     EXPONENTIAL = 0  # eta = A exp(-b T[C]) (Table 3)
     CONSTANT = 1
+    ARRHENIUS = 2  # eta = 2 eta_0(T), eta_0 = eta_ref exp(E/R (1/T - 1/T_ref)) the zero-shear law
 
 
 class NodeFlag(IntFlag):

@@ -61,6 +61,9 @@ MATERIAL_MEMBERS = (
     "viscosity_A_Pas",
     "viscosity_b_1_C",
     "viscosity_Pas",
+    "viscosity_ref_Pas",
+    "viscosity_ref_K",
+    "viscosity_activation_J_mol",
     "surface_tension_N_m",
     "solvent_viscosity_Pa_s",
     "enthalpy_reference_K",
@@ -168,10 +171,16 @@ def apparent_heat_capacity(mp: ti.template(), T):
 
 @ti.func
 def viscosity(mp: ti.template(), T):
-    """Table 3: eta = A exp(-b T[C]) (T in C as printed), or a constant."""
+    """The Perzyna viscosity eta of eq. 41. Table 3: eta = A exp(-b T[C]) (T in C as printed),
+    or a constant; or Arrhenius's zero-shear law eta_0 = eta_ref exp(E/R (1/T - 1/T_ref)) taken
+    as the melt's Newtonian viscosity: the zero-yield Perzyna melt is Newtonian with eta / 2
+    (docs/verification.md), so eta = 2 eta_0."""
     eta = mp.viscosity_Pas
     if mp.viscosity_model == ViscosityModel.EXPONENTIAL:
         eta = mp.viscosity_A_Pas * ti.exp(-mp.viscosity_b_1_C * (T - KELVIN))
+    elif mp.viscosity_model == ViscosityModel.ARRHENIUS:
+        arg = mp.viscosity_activation_J_mol / GAS_CONSTANT * (1.0 / T - 1.0 / mp.viscosity_ref_K)
+        eta = 2.0 * mp.viscosity_ref_Pas * ti.exp(arg)
     return eta
 
 

@@ -16,7 +16,7 @@ from ..physics.laser import LASER_MEMBERS
 from ..physics.materials import INT_MEMBERS, KELVIN, KINETICS_RANGE_K, MATERIAL_MEMBERS
 
 # the material keys that are temperatures (C), kept in kelvin under the same name with _K
-TEMPERATURES_C = ("melt_C", "crystallization_C")
+TEMPERATURES_C = ("melt_C", "crystallization_C", "viscosity_ref_C")
 
 
 def material_values(m: Material, enthalpy_reference_C: float) -> dict[str, float]:

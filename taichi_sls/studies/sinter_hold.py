@@ -26,6 +26,7 @@ from ..config.loading import add_set_argument
 from ..io.atomic import atomic_path
 from ..io.series import read_series
 from ..jobs.case_run import complete_summary, run_case
+from ..physics.materials import KELVIN
 from . import references as ref
 
 CASE = "sinter_hold"
@@ -38,6 +39,10 @@ def newtonian_viscosity(m: Material, T_C: np.ndarray) -> np.ndarray:
     T_C = np.asarray(T_C, dtype=float)
     if m.viscosity_model == "constant":
         return np.full_like(T_C, 0.5 * m.viscosity_Pas)
+    if m.viscosity_model == "arrhenius":  # the law is eta_N itself (config/materials.py)
+        T_ref = m.viscosity_ref_C + KELVIN
+        E = m.viscosity_activation_J_mol
+        return ref.arrhenius_viscosity(T_C + KELVIN, m.viscosity_ref_Pas, T_ref, E)
     return 0.5 * m.viscosity_A_Pas * np.exp(-m.viscosity_b_1_C * T_C)
 
 

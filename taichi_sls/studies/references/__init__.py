@@ -11,7 +11,8 @@ input and ``numpy.ndarray`` otherwise.
 - :mod:`.stefan`: Stefan melting with a linear mushy zone;
 - :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc;
 - :mod:`.hopper`: the coalescence of two equal viscous cylinders (Hopper 1984, 1990);
-- :mod:`.crystallization`: isothermal Avrami, non-isothermal Nakamura, DSC peak vs cooling rate.
+- :mod:`.crystallization`: isothermal Avrami, non-isothermal Nakamura, DSC peak vs cooling rate;
+- :mod:`.viscosity`: the Arrhenius law of a melt's zero-shear viscosity.
 """
 
 from .capillarity import *  # noqa: F403
@@ -21,3 +22,4 @@ from .hopper import *  # noqa: F403
 from .mechanics import *  # noqa: F403
 from .perzyna import *  # noqa: F403
 from .stefan import *  # noqa: F403
+from .viscosity import *  # noqa: F403
