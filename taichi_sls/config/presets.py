@@ -57,7 +57,8 @@ def expand_presets(data: Any) -> Any:
     out = dict(data)
     out["materials"] = {}
     for name, table in mats.items():
-        if isinstance(table, dict) and "preset" in table:
+        # None: a dumped material without one (model_dump keeps the unset key)
+        if isinstance(table, dict) and table.get("preset") is not None:
             preset = table["preset"]
             if not isinstance(preset, str) or preset not in preset_names():
                 raise CaseError(

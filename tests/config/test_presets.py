@@ -65,6 +65,13 @@ def test_the_paper_material_is_unchanged_without_a_preset():
     )
 
 
+def test_a_dumped_case_without_a_preset_loads_back():
+    """model_dump keeps ``preset = None``: no preset, the material as it was."""
+    case = load_case("power25W")
+    again = case_from_dict(case.model_dump())
+    assert again.materials["PA12"] == case.materials["PA12"] == Material()
+
+
 def test_an_unknown_preset_is_one_line_naming_key_value_and_names():
     with pytest.raises(CaseError) as e:
         load_case("machine_layer", ["materials.PA12.preset=pa13"])
