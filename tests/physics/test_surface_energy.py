@@ -226,9 +226,9 @@ def test_hopper_from_touching_discs_R0_h_20():
     The same run read by the per-contact section the process results rest on
     (``Simulation.necks_m``: reach ``pair_reach``, the filtered colour of
     ``contact.neck_colour``; issue #40 item 6): within 3 % (that item's bar) at all four times,
-    past the discs' initial diameter from tau ~1.45 on (measured -2.96 / -2.20 / -0.47 /
-    -0.20 % when read afterwards on the run's states; the raw colour read -13.5 / -4.7 / -0.36 /
-    +0.40 %: it keeps the one-cell notch along the node-line mid-plane that the filter closes;
+    past the discs' initial diameter from tau ~1.45 on (measured -2.87 / -2.11 / -0.38 /
+    -0.10 %; 25 min on two crowded cores; the raw colour read -13.5 / -4.7 / -0.36 / +0.40 %:
+    it keeps the one-cell notch along the node-line mid-plane that the filter closes;
     docs/verification.md)."""
     r = ver.run(ver.load("hopper", 20))
     print(r.errors)
