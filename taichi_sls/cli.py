@@ -137,6 +137,7 @@ def parser() -> argparse.ArgumentParser:
         cost_error,
         implicit_bench,
         neck_study,
+        pair_window,
         paper,
         refinement,
         robustness,
@@ -155,8 +156,8 @@ def parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub)
     bench = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, compile, cost, implicit, hold, accuracy, paper, "
-        "neck, refinement",
+        help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
+        "paper, neck, refinement",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -165,6 +166,7 @@ def parser() -> argparse.ArgumentParser:
         cost_error,
         implicit_bench,
         sinter_hold,
+        pair_window,
         accuracy,
         paper,
         neck_study,

@@ -4,7 +4,7 @@ set and colour on the nodes, the contact line of the paper's pair, the neck of e
 import numpy as np
 
 from . import struct_copy
-from .contacts import neck_width, pair_reach, point_colour
+from .contacts import filtered_colour, neck_width, pair_reach, point_colour
 from .grid_views import interface_fields
 from .monitor import neck_measures
 
@@ -75,13 +75,19 @@ class NeckMeasures:
 
     def _material_field(self, measure: str, section: str) -> np.ndarray:
         """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
-        c - 1/2 of the colour. The sections across the centres read the raw colour: they are
-        blind to the hole that the force's filter is there to close, and the filter's
-        smoothing would widen a concave neck by about kappa h^2. The column reads the colour
-        the force contours."""
+        c - 1/2 of the colour. The column reads the colour the force contours; the sections
+        across the centres the colour ``contact.neck_colour`` names (:meth:`section_colour`)."""
         if measure != "colour":
             return -self.phi()
-        return (self.raw_colour() if section == "centres" else self.colour()) - 0.5
+        if section == "centres":
+            return self.section_colour(self.raw_colour()) - 0.5
+        return self.colour() - 0.5
+
+    def section_colour(self, raw: np.ndarray) -> np.ndarray:
+        """The colour a section across the centres reads, from a raw colour: the force's filter
+        of it (``contact.neck_colour = "filtered"``, closing the notch along a node-line
+        mid-plane) or itself (``"raw"``: the seeded outline, a concave neck unwidened)."""
+        return filtered_colour(raw) if self.case.contact.neck_colour == "filtered" else raw
 
     def necks_m(self, measure: str | None = None) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``: the narrowest section
@@ -124,10 +130,11 @@ class NeckMeasures:
 
     def pair_necks_m(self) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
-        reads it but on the raw colour of the contact's two bodies alone: in a bed a section
-        across one contact also crosses the neighbours, whose material the outermost crossings
-        would count. Mass colour m_i / (rho V_cell), or the volume colour where the force uses
-        it; equal to :meth:`necks_m` on the colour for a case of two bodies."""
+        reads it but on the colour of the contact's two bodies alone (raw or filtered as
+        ``contact.neck_colour`` says): in a bed a section across one contact also crosses the
+        neighbours, whose material the outermost crossings would count. Mass colour
+        m_i / (rho V_cell), or the volume colour where the force uses it; equal to
+        :meth:`necks_m` on the colour for a case of two bodies."""
         if not self.contacts:
             return []
         pt, cfg = self.point_arrays(), self.state.cfg
@@ -144,6 +151,7 @@ class NeckMeasures:
 
         def colour(a: int, b: int) -> np.ndarray:
             sel = np.concatenate([members[a], members[b]])
-            return point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape) - 0.5
+            raw = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape)
+            return self.section_colour(raw) - 0.5
 
         return self._contact_necks(colour)

@@ -46,19 +46,28 @@ def newtonian_viscosity(m: Material, T_C: np.ndarray) -> np.ndarray:
     return 0.5 * m.viscosity_A_Pas * np.exp(-m.viscosity_b_1_C * T_C)
 
 
-def hopper_at_history(
+def hopper_clock(
     t_s: np.ndarray, T_C: np.ndarray, neck_um: np.ndarray, m: Material, R0_um: float, align_s: float
 ) -> np.ndarray:
-    """Hopper's neck (um) at each row from align_s on (NaN before): the clock integrated at the
-    recorded temperature, aligned on the run's neck at align_s (module docstring)."""
+    """Hopper's time tau at each row from align_s on (NaN before): tau_align, where Hopper's
+    neck is the run's at align_s, plus int gamma dt / (eta_N(T(t)) R0) at the recorded
+    temperature (trapezoids over the rows; module docstring)."""
     rate = m.surface_tension_N_m / (newtonian_viscosity(m, T_C) * R0_um * 1e-6)
     tau = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t_s))])
     neck0 = float(np.interp(align_s, t_s, neck_um))
     tau_rel = tau - float(np.interp(align_s, t_s, tau))
     tau_align = ref.hopper_tau_at_neck(0.5 * neck0 / R0_um)
+    return np.where(t_s >= align_s, tau_align + tau_rel, math.nan)
+
+
+def hopper_at_history(
+    t_s: np.ndarray, T_C: np.ndarray, neck_um: np.ndarray, m: Material, R0_um: float, align_s: float
+) -> np.ndarray:
+    """Hopper's neck (um) at each row from align_s on (NaN before) on :func:`hopper_clock`."""
+    tau = hopper_clock(t_s, T_C, neck_um, m, R0_um, align_s)
     out = np.full_like(t_s, math.nan, dtype=float)
     after = t_s >= align_s
-    out[after] = 2.0 * R0_um * ref.hopper_neck_at(tau_align + tau_rel[after])
+    out[after] = 2.0 * R0_um * ref.hopper_neck_at(tau[after])
     return out
 
 
@@ -68,21 +77,27 @@ def compare(out_dir: Path, align_s: float = ALIGN_S) -> list[dict]:
     s = read_series(out_dir / "timeseries.csv")
     m = next(iter(case.materials.values()))
     R0 = case.bodies[0].radius_um
+    tau = hopper_clock(s["t_s"], s["T_mean_C"], s["contact_line_um"], m, R0, align_s)
     pred = hopper_at_history(s["t_s"], s["T_mean_C"], s["contact_line_um"], m, R0, align_s)
+    eta_N = newtonian_viscosity(m, s["T_mean_C"])
     return [
         {
             "t_s": float(t),
             "dt_s": float(dt),
             "T_mean_C": float(T),
+            "eta_N_Pa_s": float(e),
+            "tau": float(c),
             "molten_fraction": float(f),
             "neck_um": float(n),
             "hopper_neck_um": float(p),
             "difference": float(n / p - 1.0) if p == p else math.nan,
         }
-        for t, dt, T, f, n, p in zip(
+        for t, dt, T, e, c, f, n, p in zip(
             s["t_s"],
             s["dt_s"],
             s["T_mean_C"],
+            eta_N,
+            tau,
             s["molten_fraction"],
             s["contact_line_um"],
             pred,

@@ -43,7 +43,7 @@ def _bed_case(tmp, absorptivity: float, end_s: float = 3e-5, frames: int = 3):
             "case": {"name": "bed6"},
             "grid": {"spacing_um": H_UM},
             "bed": {"csv": str(path)},
-            "contact": {"initial": "fillet"},
+            "contact": {"initial": "fillet", "neck_colour": "raw"},  # as the bed cases
             "lasers": [
                 {"power_W": 25.0, "x_start_um": 60.0, "off_s": 1e-3, "absorptivity": absorptivity}
             ],

@@ -38,7 +38,7 @@ def refrozen(tmp_path_factory):
             "case": {"name": "bed6_refrozen"},
             "grid": {"spacing_um": H_UM},
             "bed": {"csv": str(path)},
-            "contact": {"initial": "fillet"},
+            "contact": {"initial": "fillet", "neck_colour": "raw"},  # as the bed cases
             "materials": {"PA12": MELT},
             "thermal": {"initial_C": 140.0},
             "boundary": {"bottom": {"thermal": "fixed", "temperature_C": 140.0}},
@@ -130,7 +130,7 @@ def test_the_refrozen_layer_is_the_base_of_a_second(refrozen, tmp_path):
                 "seed": 4,
                 "x_range_um": [0.0, 120.0],
             },
-            "contact": {"initial": "fillet"},
+            "contact": {"initial": "fillet", "neck_colour": "raw"},  # as the bed cases
             "materials": {"PA12": MELT},
             "time": {"end_s": 2e-6},
             "output": {"frames": 1, "png": False, "gif": False},
