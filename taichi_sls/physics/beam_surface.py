@@ -33,7 +33,7 @@ def column_of(cfg: ti.template(), x):
 @ti.func
 def find_column_tops(cfg: ti.template(), pt: ti.template(), tops: ti.template()):
     """tops[column] = the highest point top in each column (NO_SURFACE where none)."""
-    for I in ti.grouped(tops):
+    for I in ti.grouped(ti.ndrange(*tops.shape)):  # a range: a struct-for cannot nest
         tops[I] = NO_SURFACE
     for p in range(cfg.n_points):
         ti.atomic_max(tops[column_of(cfg, pt.x[p])], pt.x[p][1] + cfg.lp)

@@ -15,6 +15,7 @@ HEAT_ONLY = {"mechanics": False, "surface_tension": False}
 SIDE_UM, DEPTH_UM, H_UM = 64.0, 20.0, 4.0
 A, P, R0_UM, ETA_UM = 0.85, 2.0, 8.0, 100.0
 ON_S = 4e-5  # the stationary spot's on-time
+P_GAP = 0.01  # W: the narrow spot of the gap tests keeps the block below 200 C
 
 
 def _block(dim: int, lasers: list) -> Simulation:
@@ -104,3 +105,63 @@ def test_hatched_tracks_in_3d_balance_the_enthalpy():
     # the centre travels 32 um in 32 us: the line energy (depth law as the rows sample it)
     # over that length; the spot's tails beyond the box's ends (2 r0 away) carry 3e-5 at most
     assert per_track[0] == pytest.approx(line * 32e-6, rel=1e-4)
+
+
+def _gap(dim: int, surface: str, upper: bool) -> float:
+    """The laser energy (J/m in 2D, J in 3D) a narrow stationary spot delivers over ON_S to a
+    lower block (x 40..80 um, 20 um high) beside an upper one (x 0..30 um, y 40..60 um, absent
+    when not ``upper``), depth measured from ``surface``; the spot 4 r0 inside the lower block."""
+    lower = {"shape": "rect", "min_um": [40.0, 0.0], "max_um": [80.0, 20.0]}
+    bodies = [lower] + ([{"shape": "rect", "min_um": [0.0, 40.0], "max_um": [30.0, 60.0]}] * upper)
+    data = {
+        "grid": {"spacing_um": H_UM},
+        "domain": {"dim": dim, "width_um": 80.0, "height_um": 64.0},
+        "bodies": bodies,
+        "physics": HEAT_ONLY,
+        "boundary": {w: {"thermal": "insulated"} for w in WALLS[: 2 * dim]},
+        "lasers": [
+            _spot(
+                power_W=P_GAP,
+                x_start_um=60.0,
+                spot_radius_um=5.0,
+                penetration_depth_um=10.0,
+                surface=surface,
+            )
+        ],
+        "time": {"dt_s": 2e-6},
+    }
+    if dim == 3:
+        data["domain"]["depth_um"] = 40.0
+        for b in data["bodies"]:
+            b["min_um"], b["max_um"] = [*b["min_um"], 0.0], [*b["max_um"], 40.0]
+    sim = Simulation(make_case(data))
+    sim.advance(round(ON_S / sim.dt) + 3)
+    return sim.monitors()["laser_energy_J_per_m"]
+
+
+def test_local_surface_absorbs_from_the_particles_own_top_2d():
+    """A lower block under the beam, an upper one beside it (a gap above the lower block): with
+    surface = "local" the lower block absorbs from its own top, exactly as it does alone (its
+    column's highest point top is its own top; to round-off); the scene reading measures its
+    depth from the upper block's top, 40 um higher, so it takes exp(-40 / eta) of that (to
+    round-off: the depths differ by 40 um at every point). The spot (r0 = 5 um) lies 30 um
+    from the upper block: its share there is exp(-2 (30/5)^2) = 6e-32."""
+    alone = _gap(2, "scene", upper=False)
+    local = _gap(2, "local", upper=True)
+    scene = _gap(2, "scene", upper=True)
+    print(f"alone {alone:.12e}, local {local:.12e}, scene {scene:.12e} J/m")
+    assert local == pytest.approx(alone, rel=1e-12)
+    assert scene == pytest.approx(alone * math.exp(-40.0 / 10.0), rel=1e-12)
+
+
+@pytest.mark.slow
+def test_local_surface_absorbs_from_the_particles_own_top_3d():
+    """The same in 3D, against the closed form: the lower block takes 0.6 A P ON_S times the
+    depth law summed by its point rows from its own top (eta = 10 um, 20 um deep; the spot
+    lies 4 r0 inside it, 0.5 erfc(4 sqrt 2) = 8e-16 outside), to 1e-12."""
+    local = _gap(3, "local", upper=True)
+    d, eta = 0.5 * H_UM * 1e-6, 10e-6
+    rows = d * math.exp(-d / (2 * eta)) * (1 - math.exp(-20e-6 / eta)) / (1 - math.exp(-d / eta))
+    exact = 0.6 * A * P_GAP * ON_S * rows / eta
+    print(f"local {local:.12e} J, closed form {exact:.12e} J")
+    assert local == pytest.approx(exact, rel=1e-12)
