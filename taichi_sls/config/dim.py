@@ -1,6 +1,7 @@
 """The case's dimension (``domain.dim``): coordinates of the right length, and in 3D a one-line
 refusal of everything the 3D solver does not build yet (or, for the polygon outline and the
-paper's level-set CSF, ever), each naming its key, its value and what is allowed."""
+paper's level-set CSF, ever), each naming its key, its value and what is allowed; the laser's
+3D keys checked against the dimension."""
 
 from __future__ import annotations
 
@@ -27,8 +28,43 @@ def check_dimension(case: Any) -> None:
                 f"domain.depth_um = {case.domain.depth_um}: 3D only (domain.dim = 2 is a plane "
                 "section, per unit depth)"
             )
+        for i, las in enumerate(case.lasers):
+            for key, v, allowed in (
+                ("direction", las.direction, '"x" (the plane\'s x)'),
+                ("z_start_um", las.z_start_um, "unset"),
+                ("z_end_um", las.z_end_um, "unset"),
+            ):
+                if v != ("x" if key == "direction" else None):
+                    raise CaseError(
+                        f"lasers[{i}].{key} = {v!r}: 3D only (domain.dim = 2; allowed: {allowed})"
+                    )
         return
     _refuse_in_3d(case)
+    _check_lasers_3d(case)
+
+
+def _check_lasers_3d(case: Any) -> None:
+    """The 3D spot (physics/laser.py): tracks lie in the bed, so no plane to cross; the end key
+    names the scan axis; z_start_um defaults to the mid-depth (set here, so a dump carries it)."""
+    for i, las in enumerate(case.lasers):
+        if las.scan == "across":
+            raise CaseError(
+                f'lasers[{i}].scan = "across" with domain.dim = 3: a 3D bed holds its tracks; '
+                'allowed in 3D: "along" (with tracks, hatch_um, return_s and direction)'
+            )
+        other = "x_end_um" if las.direction == "z" else "z_end_um"
+        if getattr(las, other) is not None:
+            raise CaseError(
+                f"lasers[{i}].{other} = {getattr(las, other)} with direction = "
+                f'"{las.direction}": the end is along the scan direction (allowed: unset)'
+            )
+        if las.tracks > 1 and las.return_s is None:
+            raise CaseError(
+                f"lasers[{i}].return_s = None: {las.tracks} tracks need the time between "
+                "their starts (allowed: > 0 s)"
+            )
+        if las.z_start_um is None:
+            las.z_start_um = 0.5 * case.domain.depth()
 
 
 def _check_coordinates(case: Any, dim: int) -> None:
@@ -122,12 +158,6 @@ def _refuse_in_3d(case: Any) -> None:
             f'solver.layout = "blocks" with domain.dim = 3: the race-free colouring is 4 '
             f'colours of 2D blocks, {not_yet}; allowed in 3D: "auto", "serial", "parallel"'
         )
-    for i, las in enumerate(case.lasers):
-        if las.power_W > 0:
-            raise CaseError(
-                f"lasers[{i}].power_W = {las.power_W} with domain.dim = 3: the laser spot (a "
-                f"Gaussian in x) is {not_yet}; allowed in 3D: 0 or no [[lasers]]"
-            )
     out = case.output
     for key in ("png", "gif", "vtu"):
         if key in out.model_fields_set and getattr(out, key):

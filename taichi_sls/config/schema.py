@@ -250,7 +250,12 @@ class Case(Model):
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
-            if las.scan == "along" and las.tracks > 1:
+            if las.surface == "local" and las.top_um is not None:
+                raise CaseError(
+                    f'lasers[{i}].top_um = {las.top_um}: surface = "local" reads the surface '
+                    'in each column (allowed: unset, or surface = "scene")'
+                )
+            if las.scan == "along" and las.tracks > 1 and self.domain.dim == 2:
                 raise CaseError(
                     f'lasers[{i}].tracks = {las.tracks}: hatches need scan = "across" '
                     '(allowed with scan = "along": 1)'
@@ -354,12 +359,14 @@ class Case(Model):
         return self.time.heat_integrator == "implicit"
 
     def lasers_off_s(self) -> float:
-        """The time after which no laser heats (s): switched off, or scanned past x_end_um."""
+        """The time after which no laser heats (s): switched off, or scanned past its end."""
         ends = [0.0]
         for las in self.lasers:
             end = las.off_s
             if las.scan == "across":
                 end = min(end, las.track_windows_s()[-1][1])
+            elif self.domain.dim == 3:
+                end = min(end, las.track_windows_along_s()[-1][1])
             elif las.speed_m_s != 0.0 and las.x_end_um is not None:
                 end = min(end, las.on_s + (las.x_end_um - las.x_start_um) * 1e-6 / las.speed_m_s)
             ends.append(max(end, las.on_s) if las.power_W > 0 else 0.0)

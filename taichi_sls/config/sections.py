@@ -257,10 +257,21 @@ class Laser(Model):
     x_start_um: float = Field(
         40.0, description="beam centre at on_s (um); scan = across: the first track's x (um)"
     )
+    z_start_um: float | None = Field(
+        None,
+        description="3D only: the beam centre's z at on_s (um; the first track's z when the "
+        "tracks run along x); default the domain's mid-depth",
+    )
+    direction: Literal["x", "z"] = Field(
+        "x",
+        description="3D only: the scan direction in the bed plane (x or z; y is up); the spot "
+        "moves along +direction at speed_m_s and track k is offset k hatch_um along the other "
+        'bed axis (docs/model.md, "The laser in 3D"); 2D: x',
+    )
     speed_m_s: float = Field(
         0.0,
-        description="scan speed along +x (m/s); 0 = stationary. scan = across: the speed along "
-        "the tracks, normal to the plane (> 0)",
+        description="scan speed along +x (m/s; 3D: along +direction); 0 = stationary. scan = "
+        "across: the speed along the tracks, normal to the plane (> 0)",
     )
     scan: Literal["along", "across"] = Field(
         "along",
@@ -271,19 +282,39 @@ class Laser(Model):
         "line energy A P / v, so the mean energy per area is A P / (v hatch) (docs/model.md, "
         "'Hatches')",
     )
-    tracks: int = Field(1, ge=1, le=1000, description="scan = across: number of tracks")
-    hatch_um: float = Field(100.0, gt=0, description="scan = across: hatch distance (um)")
+    tracks: int = Field(
+        1,
+        ge=1,
+        le=1000,
+        description="number of tracks: scan = across (2D), or 3D, where they lie in the bed",
+    )
+    hatch_um: float = Field(
+        100.0, gt=0, description="distance between tracks (um): scan = across (2D), or 3D"
+    )
     return_s: float | None = Field(
         None,
         gt=0,
-        description="scan = across: time between successive tracks' passes through the plane "
-        "(s; a machine's track length / speed plus its turn); needed for tracks > 1",
+        description="time between successive tracks (s; a machine's track length / speed plus "
+        "its turn): scan = across, between passes through the plane; 3D, between track starts "
+        "(a track heats until the next one starts); needed for tracks > 1",
     )
     x_end_um: float | None = Field(
-        None, description="beam switches off when its centre passes this x"
+        None, description="beam switches off when its centre passes this x (3D: each track)"
+    )
+    z_end_um: float | None = Field(
+        None,
+        description='3D, direction = "z": each track stops heating when its centre passes this '
+        "z (um)",
     )
     top_um: float | None = Field(
         None, description="y_l, top of the powder; default: highest body top"
+    )
+    surface: Literal["scene", "local"] = Field(
+        "scene",
+        description="where the depth of eq. 31 is measured from: scene, y_l (top_um, or the "
+        "highest body top as seeded); local, the surface the beam meets first above the point: "
+        "the highest point top in the grid column (2D: x; 3D: x, z) holding the point, each "
+        'heat step (docs/model.md, "The beam\'s first surface")',
     )
     source_units: Literal["W_per_m3", "W_per_kg"] = Field(
         "W_per_m3",
@@ -295,6 +326,23 @@ class Laser(Model):
         description="decay: exp(-(y_l - y)/eta) (docs/model.md); paper: exp(+(y_l - y)/eta) as "
         "printed",
     )
+
+    def track_windows_along_s(self) -> list[tuple[float, float]]:
+        """scan = along: each track's heating window (s). Track k starts at on_s + k return_s
+        and heats until off_s, the next track's start, or its centre passing the end key
+        (x_end_um, or z_end_um for direction = "z")."""
+        end_um = self.z_end_um if self.direction == "z" else self.x_end_um
+        start_um = self.z_start_um if self.direction == "z" else self.x_start_um
+        out = []
+        for k in range(self.tracks):
+            on = self.on_s + k * (self.return_s or 0.0)
+            end = self.off_s
+            if k < self.tracks - 1:
+                end = min(end, on + (self.return_s or 0.0))
+            if self.speed_m_s != 0.0 and end_um is not None and start_um is not None:
+                end = min(end, on + (end_um - start_um) * 1e-6 / self.speed_m_s)
+            out.append((min(on, self.off_s), max(end, on)))
+        return out
 
     def pass_half_s(self) -> float:
         """scan = across: half the time a pass heats the plane (s), PASS_HALF_WIDTH r0 / v; the

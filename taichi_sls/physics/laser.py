@@ -11,7 +11,17 @@ Hatches (``across`` = 1, docs/model.md "Hatches"): the plane is a section across
 Track k runs normal to the plane at x_k = ``x_start_m`` + k ``hatch_m``; its spot crosses the
 plane at t_k = ``on_s`` + ``pass_half_s`` + k ``return_s`` at ``speed_m_s`` = v, so the plane sees
 the Gaussian in time exp(-2 v^2 (t - t_k)^2 / r0^2) within t_k +- ``pass_half_s``. A step takes
-its exact time mean (erf), so the energy a pass delivers does not depend on the step."""
+its exact time mean (erf), so the energy a pass delivers does not depend on the step.
+
+3D (docs/model.md, "The laser in 3D"): eq. 31 is a spot in the bed plane (x, z), the Gaussian
+exp(-2 r^2 / r0^2) of the distance r from its centre, which moves along x (``along_z`` = 0) or
+z (1) at ``speed_m_s``. Track k starts at ``on_s`` + k ``return_s`` at the same start along the
+scan, offset k ``hatch_m`` along the other bed axis, and heats until ``off_s``, the next track's
+start, or its centre passing the end (``x_end_m`` or ``z_end_m``). Its plane integral is A P
+times the depth factor (2D: the central section's A P sqrt(2 / pi) / r0, per unit depth).
+
+Depth: below y_l = ``top_m`` (the scene's top), or with ``local_surface`` = 1 below the local
+surface, the highest point top in the point's grid column (physics/beam_surface.py)."""
 
 from taichi_sls.backend import ti
 
@@ -31,6 +41,10 @@ LASER_MEMBERS = (
     "hatch_m",
     "return_s",
     "pass_half_s",
+    "z_start_m",
+    "z_end_m",
+    "along_z",
+    "local_surface",
 )
 
 # erf by Abramowitz & Stegun 7.1.26 (absolute error below 1.5e-7): Taichi has none
@@ -75,15 +89,62 @@ def hatch_source(las: ti.template(), xp, t, dt):
 
 
 @ti.func
-def laser_source(lasers: ti.template(), n_lasers: ti.template(), xp, t, dt):
+def spot_source_3d(las: ti.template(), xp, t, dt):
+    """Mean power per unit volume at xp over [t, t + dt] of a 3D beam's tracks in the bed
+    (module docstring), without the depth factor; each track's on-time within the step exact,
+    its centre taken at the middle of that time."""
+    s = 0.0
+    r0 = las.spot_radius_m
+    speed = las.speed_m_s
+    start, end, lateral0 = las.x_start_m, las.x_end_m, las.z_start_m
+    along, across = xp[0], xp[2]
+    if las.along_z > 0.0:
+        start, end, lateral0 = las.z_start_m, las.z_end_m, las.x_start_m
+        along, across = xp[2], xp[0]
+    n = ti.cast(las.tracks, ti.i32)
+    for k in range(n):
+        on = las.on_s + k * las.return_s
+        t0 = ti.max(t, on)
+        t1 = ti.min(t + dt, las.off_s)
+        if k < n - 1:
+            t1 = ti.min(t1, on + las.return_s)
+        # the track is off while its centre start + speed (t - on) lies beyond end
+        if speed > 0.0:
+            t1 = ti.min(t1, on + (end - start) / speed)
+        elif speed < 0.0:
+            t0 = ti.max(t0, on + (end - start) / speed)
+        elif start > end:
+            t1 = t0
+        if t1 > t0:
+            da = start + speed * (0.5 * (t0 + t1) - on) - along
+            dl = lateral0 + k * las.hatch_m - across
+            s += ((t1 - t0) / dt) * ti.exp(-2.0 * (da * da + dl * dl) / (r0 * r0))
+    return s
+
+
+@ti.func
+def laser_source(cfg: ti.template(), lasers: ti.template(), xp, t, dt, column_top):
     """Mean power per unit volume at xp over [t, t + dt], summed over the beams. Each beam's
     on-time within the step is exact (a heat step may span many mechanical steps and a switch-on
-    or -off), its position taken at the middle of that time."""
+    or -off), its position taken at the middle of that time. ``column_top``: the local surface
+    above xp (used by beams with ``local_surface``; cfg.local_surface compiles it in)."""
     s = 0.0
-    for k in range(n_lasers):
+    for k in range(cfg.n_lasers):
         las = lasers[k]
+        top = las.top_m
+        if ti.static(cfg.local_surface):
+            if las.local_surface > 0.0:
+                top = column_top
+        if ti.static(cfg.dim == 3):
+            depth = ti.max(top - xp[1], 0.0)
+            s += (
+                las.amplitude_W_m3
+                * spot_source_3d(las, xp, t, dt)
+                * ti.exp(-las.depth_sign * depth / las.penetration_depth_m)
+            )
+            continue
         if las.across > 0.0:
-            depth = ti.max(las.top_m - xp[1], 0.0)
+            depth = ti.max(top - xp[1], 0.0)
             s += (
                 las.amplitude_W_m3
                 * hatch_source(las, xp, t, dt)
@@ -107,7 +168,7 @@ def laser_source(lasers: ti.template(), n_lasers: ti.template(), xp, t, dt):
             xl = x0 + speed * (0.5 * (t0 + t1) - on)
             r0 = las.spot_radius_m
             eta = las.penetration_depth_m
-            depth = ti.max(las.top_m - xp[1], 0.0)
+            depth = ti.max(top - xp[1], 0.0)
             dx = xl - xp[0]
             s += (
                 las.amplitude_W_m3

@@ -162,10 +162,12 @@ def p2g_heat_flux(
     dw,
     t,
     dt,
+    column_top,
 ):
     """Conduction (eq. 29, weak-form sign) and laser (eqs. 30-31) into the nodes' heat rate;
     with the sub-grid filter on, the point's deviation from the grid temperature too. Returns
-    the laser energy the point took (J/m)."""
+    the laser energy the point took (J/m). ``column_top``: the local surface above the point
+    (physics/beam_surface.py), read by beams that measure their depth from it."""
     gT = ti.Vector(ZERO_VECTOR[cfg.dim])
     T_grid = 0.0
     w_fixed = 0.0
@@ -192,7 +194,7 @@ def p2g_heat_flux(
     s = 0.0
     energy = 0.0  # the laser energy the point takes this heat step
     if ti.static(cfg.laser):
-        s = laser_source(lasers, cfg.n_lasers, pt.x[p], t, dt)
+        s = laser_source(cfg, lasers, pt.x[p], t, dt, column_top)
         energy = Vp * s * dt
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)

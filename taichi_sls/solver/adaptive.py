@@ -83,6 +83,8 @@ def laser_switch_times(case: Case) -> list[float]:
             edges.add(las.on_s)
             if las.scan == "across":  # each pass starts and ends on time
                 edges.update(e for window in las.track_windows_s() for e in window)
+            elif case.domain.dim == 3:  # each track in the bed starts and ends on time
+                edges.update(e for window in las.track_windows_along_s() for e in window)
     edges.add(case.lasers_off_s())
     return sorted(e for e in edges if e > 0.0)
 

@@ -30,6 +30,7 @@ import numpy as np
 
 from taichi_sls.backend import ti
 
+from ..physics.beam_surface import column_shape
 from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix
 from ..physics.laser import laser_struct
@@ -206,6 +207,8 @@ class State:
         self.materials = material_struct().field(shape=n_mat, layout=ti.Layout.SOA)
         self.lasers = laser_struct().field(shape=max(cfg.n_lasers, 1), layout=ti.Layout.SOA)
         self.surf = SurfaceScratch(cfg.nx, cfg.ny)
+        # the beam's local surface per column (physics/beam_surface.py); one cell when unused
+        self.column_top = ti.field(float, column_shape(cfg) if cfg.local_surface else (1,))
         # active region [i0, j0, i1, j1) ([i0, j0, k0, i1, j1, k1) in 3D): lower corner, upper
         self.box = ti.Vector.field(2 * cfg.dim, ti.i32, ())
         self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())

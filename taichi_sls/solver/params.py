@@ -101,6 +101,10 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
                 hatch_m=las.hatch_um * 1e-6,
                 return_s=las.return_s or 0.0,
                 pass_half_s=las.pass_half_s() if las.scan == "across" else 0.0,
+                z_start_m=(las.z_start_um or 0.0) * 1e-6,
+                z_end_m=(las.z_end_um if las.z_end_um is not None else 1e9) * 1e-6,
+                along_z=1.0 if las.direction == "z" else 0.0,
+                local_surface=1.0 if las.surface == "local" else 0.0,
             )
         )
     return {k: np.array([r[k] for r in rows], dtype=float) for k in LASER_MEMBERS}

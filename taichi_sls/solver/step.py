@@ -28,6 +28,7 @@ loop. Staged (the speed benchmark's comparison only): one kernel call per stage.
 
 from taichi_sls.backend import ti
 
+from ..physics.beam_surface import column_of, find_column_tops
 from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
@@ -187,7 +188,11 @@ def _heat_flux_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.tem
     t = st.scalars.t[None]
     pt = ti.static(st.points)
     base, w, dw = point_stencil(st.cfg, pt, p)
-    e = p2g_heat_flux(st.cfg, pt, st.nodes, st.materials, st.lasers, p, base, w, dw, t, dt_heat)
+    top = 0.0
+    if ti.static(st.cfg.local_surface):
+        top = st.column_top[column_of(st.cfg, pt.x[p])]
+    nd, mat = ti.static(st.nodes, st.materials)
+    e = p2g_heat_flux(st.cfg, pt, nd, mat, st.lasers, p, base, w, dw, t, dt_heat, top)
     if ti.static(st.cfg.laser):
         add_laser_energy(st, blk, e)
 
@@ -198,8 +203,15 @@ def _heat_flux_loop(st: ti.template()):
 
 
 @ti.func
+def _column_tops(st: ti.template()):
+    find_column_tops(st.cfg, st.points, st.column_top)
+
+
+@ti.func
 def heat_flux(st: ti.template(), heat: ti.template(), geom: ti.template()):
     if ti.static(st.cfg.thermal):
+        if ti.static(st.cfg.local_surface):
+            on_clock(st, heat, _column_tops)
         on_clock(st, heat, _heat_flux_loop)
         if ti.static(st.cfg.top_loss):
             on_clock(st, heat, top_loss_in_order)

@@ -73,6 +73,7 @@ class StepConfig:
     th_strain: bool
     laser: bool
     n_lasers: int
+    local_surface: bool  # some beam reads its depth below the local surface (beam_surface.py)
     gravity: tuple[float, ...]  # dim components
     has_gravity: bool
     stress_reading: StressReading
@@ -215,6 +216,8 @@ def step_config(
         th_strain=ph.thermal_strain and thermal,
         laser=thermal and any(las.power_W > 0 for las in case.lasers),
         n_lasers=len(case.lasers),
+        local_surface=thermal
+        and any(las.power_W > 0 and las.surface == "local" for las in case.lasers),
         gravity=tuple(ph.gravity_m_s2) + (0.0,) * (dim - len(ph.gravity_m_s2)),
         has_gravity=any(g != 0.0 for g in ph.gravity_m_s2),
         stress_reading=StressReading.PAPER if sv.stress_reading == "paper" else StressReading.MODEL,

@@ -81,6 +81,7 @@ STUDIES = (
     Study("erf", (4.0, 2.0, 1.0), (4.0, 2.0), "temperature_rms", f32_at=(2.0,)),
     Study("gaussian", (4.0, 2.0, 1.0), (4.0, 2.0), "temperature_rms", f32_at=(2.0,)),
     Study("stefan", (25, 50, 100), (25,), "melt_front"),
+    Study("spot3d", (8.0, 4.0, 2.0), (8.0, 4.0), "centre"),  # 3D: 25 min at h = 2 um
     Study("energy", (4.0, 2.0), (4.0,), "energy_balance", f32_at=(4.0,)),
     Study("curvature", (10, 20, 40), (10, 20), "curvature_mean"),
     Study("laplace", (10, 20, 40), (10,), "pressure", csf_at=(10, 20, 40)),

@@ -92,7 +92,7 @@ REFUSED_IN_3D = [
     ({"time": {"stop": "solidified"}}, 'time.stop = "solidified"'),
     ({"thermal": {"top_surface": "chamber"}}, "thermal.top_surface = 'chamber'"),
     ({"solver": {"layout": "blocks"}}, 'solver.layout = "blocks"'),
-    ({"lasers": [{"power_W": 25.0}]}, "lasers[0].power_W = 25.0"),
+    ({"lasers": [{"scan": "across", "speed_m_s": 5.0}]}, 'lasers[0].scan = "across"'),
     ({"output": {"png": True}}, "output.png = true"),
     ({"output": {"vtu": True}}, "output.vtu = true"),
     ({"grid": {"seeding": "area"}}, 'grid.seeding = "area"'),
@@ -107,3 +107,38 @@ def test_what_3d_lacks_is_refused_by_its_key(extra, says):
     # and the same keys stay allowed in 2D (the bodies and the bed need their own scenes)
     if "bodies" not in extra:
         case_from_dict(deep_update(PAPER_SCENE, extra))
+
+
+def test_the_laser_loads_in_3d_with_its_keys():
+    """A beam with power runs in 3D: z_start_um defaults to the mid-depth (and is dumped), the
+    tracks lie in the bed (scan = "along" with tracks > 1), each ends at its end key."""
+    beam = {"power_W": 25.0, "speed_m_s": 2.0, "direction": "z", "z_start_um": 0.0}
+    hatch = {**beam, "tracks": 3, "hatch_um": 10.0, "return_s": 1e-5, "z_end_um": 8.0}
+    hatch["off_s"] = 1.0
+    case = case_from_dict(deep_update(SPHERE, {"lasers": [hatch]}))
+    windows = case.lasers[0].track_windows_along_s()
+    flat = [e for window in windows for e in window]
+    assert flat == pytest.approx([0.0, 4e-6, 1e-5, 1.4e-5, 2e-5, 2.4e-5], rel=1e-12)
+    assert case.lasers_off_s() == pytest.approx(2.4e-5, rel=1e-12)
+    plain = case_from_dict(deep_update(SPHERE, {"lasers": [{"power_W": 25.0}]}))
+    assert plain.lasers[0].z_start_um == 16.0  # the mid-depth of 32 um
+    assert case_from_dict(case_to_dict(plain)).lasers[0].z_start_um == 16.0
+
+
+LASER_REFUSED = [
+    (3, {"tracks": 2}, "lasers[0].return_s = None: 2 tracks need the time between their starts"),
+    (3, {"direction": "z", "x_end_um": 5.0}, 'lasers[0].x_end_um = 5.0 with direction = "z"'),
+    (3, {"z_end_um": 5.0}, 'lasers[0].z_end_um = 5.0 with direction = "x"'),
+    (2, {"direction": "z"}, "lasers[0].direction = 'z': 3D only"),
+    (2, {"z_start_um": 4.0}, "lasers[0].z_start_um = 4.0: 3D only"),
+    (2, {"z_end_um": 4.0}, "lasers[0].z_end_um = 4.0: 3D only"),
+    (2, {"tracks": 2}, 'lasers[0].tracks = 2: hatches need scan = "across"'),
+    (2, {"surface": "local", "top_um": 30.0}, 'lasers[0].top_um = 30.0: surface = "local"'),
+]
+
+
+@pytest.mark.parametrize("dim, laser, says", LASER_REFUSED, ids=[s for *_, s in LASER_REFUSED])
+def test_laser_keys_refused_by_dimension(dim, laser, says):
+    scene = SPHERE if dim == 3 else PAPER_SCENE
+    msg = _error(deep_update(scene, {"lasers": [{"power_W": 25.0, **laser}]}))
+    assert msg.startswith(says) and "allowed" in msg

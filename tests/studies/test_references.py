@@ -389,3 +389,23 @@ def test_hopper_late_time_limit():
         assert ref.hopper_tau(ref.hopper_nu(tau)) == pytest.approx(tau, rel=1e-10)
         assert ref.hopper_tau_at_neck(ref.hopper_neck_at(tau)) == pytest.approx(tau, rel=1e-9)
     assert ref.hopper_neck_at(1.0) == pytest.approx(0.8258, abs=1e-4)
+
+
+def test_gaussian_spot_halfspace_surface_limit_and_depth():
+    """The 3D spot's reference: as the depth law thins (eta -> 0, depth 0) the centre rise
+    tends, linearly in eta, to the surface source's closed form sqrt(2) P / (pi^(3/2) k r0)
+    arctan(sqrt(8 alpha t) / r0) (derived from the same point source; its steady limit P /
+    (sqrt(2 pi) k r0)); the rise falls off the axis and with depth; it is linear in P."""
+    k, rho_c, r0, P = 0.28, 1020 * 2700.0, 20e-6, 1e-3
+    alpha, t = k / rho_c, 5e-4
+    surface = math.sqrt(2) * P / (math.pi**1.5 * k * r0) * math.atan(math.sqrt(8 * alpha * t) / r0)
+    errs = [
+        ref.gaussian_spot_halfspace(0.0, 0.0, t, P, r0, eta, 1.0, k, rho_c) / surface - 1
+        for eta in (1e-8, 1e-9)
+    ]
+    assert abs(errs[1]) < 2e-4 and errs[0] == pytest.approx(10 * errs[1], rel=0.01)
+    centre = ref.gaussian_spot_halfspace(0.0, 1e-6, t, P, r0, 10e-6, 40e-6, k, rho_c)
+    assert ref.gaussian_spot_halfspace(10e-6, 1e-6, t, P, r0, 10e-6, 40e-6, k, rho_c) < centre
+    assert ref.gaussian_spot_halfspace(0.0, 10e-6, t, P, r0, 10e-6, 40e-6, k, rho_c) < centre
+    double = ref.gaussian_spot_halfspace(0.0, 1e-6, t, 2 * P, r0, 10e-6, 40e-6, k, rho_c)
+    assert double == pytest.approx(2 * centre, rel=1e-9)

@@ -1,9 +1,14 @@
-"""Heat conduction: the erf half-space and the spreading 2D Gaussian."""
+"""Heat conduction: the erf half-space, the spreading 2D Gaussian, and a stationary Gaussian
+laser spot absorbed with depth in an insulated half-space (3D)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.integrate import quad
+from scipy.special import erfcx
 
 from ._util import erf, out
 
@@ -35,3 +40,66 @@ def gaussian_spread_2d(
     t = np.asarray(t, dtype=float)
     s2 = sigma0**2 + 2.0 * alpha * t
     return out(E_per_length / (rho_c * 2.0 * np.pi * s2) * np.exp(-r2 / (2.0 * s2)))
+
+
+def gaussian_spot_halfspace(
+    radius: float,
+    depth: float,
+    t: float,
+    power: float,
+    r0: float,
+    eta: float,
+    thickness: float,
+    k: float,
+    rho_c: float,
+) -> float:
+    """Temperature rise (K) at ``radius`` from the axis and ``depth`` below the surface of an
+    insulated half-space, heated from t = 0 by the stationary source (W/m^3)
+
+        q(r, z) = power 2 / (pi r0^2) exp(-2 r^2 / r0^2) exp(-z / eta) / eta,  0 <= z <= thickness
+
+    (eq. 31's spot and depth law: power = 0.6 A P, the absorbed power over an infinite depth).
+    The instantaneous point source in an infinite solid, exp(-R^2 / 4 alpha s) / (rho c (4 pi
+    alpha s)^(3/2)) (Carslaw & Jaeger 1959, Conduction of Heat in Solids, sec. 10.2), and its
+    image in the plane z = 0 (the insulated surface, sec. 10.10) give, after the Gaussian's
+    integral over the plane in closed form (the convolution of two Gaussians, variances
+    r0^2 / 4 and 2 alpha s per axis),
+
+        dT = power 2 / (pi rho c sqrt(4 pi alpha)) int_0^t ds / sqrt(s)
+             exp(-2 radius^2 / (r0^2 + 8 alpha s)) / (r0^2 + 8 alpha s) g(s),
+        g(s) = int_0^thickness exp(-z / eta) / eta [G(depth - z) + G(depth + z)] dz,
+        G(u) = exp(-u^2 / (4 alpha s)),
+
+    g in closed form by erfc, the time integral by quadrature (s = u^2, smooth). A surface
+    source (eta -> 0, thickness infinite) at depth 0 gives the centre rise sqrt(2) power /
+    (pi^(3/2) k r0) arctan(sqrt(8 alpha t) / r0), whose steady value power / (sqrt(2 pi) k r0)
+    is the stationary Gaussian source's (Carslaw & Jaeger sec. 10.5 for a disc source has the
+    same form; e.g. Cline & Anthony 1977, J. Appl. Phys. 48, 3895, at zero speed)."""
+    alpha = k / rho_c
+
+    def g(s: float) -> float:
+        w = 2.0 * math.sqrt(alpha * s)
+        total = 0.0
+        for a in (depth, -depth):  # the source's own term and its image
+            b = a - 2.0 * alpha * s / eta  # exp(-z/eta - (z - a)^2 / w^2) peaks at z = b
+            # exp(-a/eta + alpha s/eta^2) [erfc(-b/w) - erfc((thickness - b)/w)], each term
+            # scaled by erfcx where its argument is >= 0 (the exponents then -a^2/w^2 and
+            # -(thickness - a)^2/w^2 - thickness/eta, no overflow for a thin source)
+            x0, x1 = -b / w, (thickness - b) / w
+            if x0 >= 0.0:
+                near = math.exp(-((a / w) ** 2)) * erfcx(x0)
+            else:
+                near = math.exp(-a / eta + alpha * s / eta**2) * math.erfc(x0)
+            far = math.exp(-(((thickness - a) / w) ** 2) - thickness / eta) * erfcx(x1)
+            total += 0.5 * w * math.sqrt(math.pi) / eta * (near - far)
+        return total
+
+    def integrand(u: float) -> float:
+        s = u * u
+        if s == 0.0:
+            return 0.0
+        spread = r0 * r0 + 8.0 * alpha * s
+        return 2.0 * math.exp(-2.0 * radius**2 / spread) / spread * g(s)
+
+    integral, _ = quad(integrand, 0.0, math.sqrt(t), epsabs=0.0, epsrel=1e-10, limit=200)
+    return power * 2.0 / (math.pi * rho_c * math.sqrt(4.0 * math.pi * alpha)) * integral

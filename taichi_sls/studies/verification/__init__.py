@@ -18,7 +18,7 @@ from .capillarity import (
     run_viscous_decay,
 )
 from .common import Result
-from .heat import run_energy, run_erf, run_gaussian, run_stefan
+from .heat import run_energy, run_erf, run_gaussian, run_spot3d, run_stefan
 from .hopper import run_hopper
 from .mechanics import perzyna_history, run_bar, run_finite_strain, run_perzyna, run_steffen
 from .spec import VerificationCase, case_names, case_path, load, load_file
@@ -30,6 +30,7 @@ RUNNERS: dict[str, Callable[[VerificationCase], Result]] = {
     "finite_strain": run_finite_strain,
     "erf": run_erf,
     "gaussian": run_gaussian,
+    "spot3d": run_spot3d,
     "stefan": run_stefan,
     "energy": run_energy,
     "curvature": run_curvature,

@@ -1,5 +1,5 @@
 """Verification of the heat: erf half-space, mushy Stefan melting, spreading Gaussian, energy
-balance."""
+balance, a 3D Gaussian laser spot on a half-space."""
 
 from __future__ import annotations
 
@@ -110,4 +110,52 @@ def run_energy(vc: VerificationCase) -> Result:
     err = abs(rise + mon["heat_out_J_per_m"] - laser) / laser
     return result(
         case, sim, {"energy_balance": err}, t0, heat_out_fraction=mon["heat_out_J_per_m"] / laser
+    )
+
+
+def run_spot3d(vc: VerificationCase) -> Result:
+    """A stationary 3D laser spot on an insulated block against
+    references.gaussian_spot_halfspace: the rise of the top row of points relative to the exact
+    rise on the axis, at the points nearest the axis ("centre", signed) and the largest over
+    the top points within r0 of the axis ("surface_max")."""
+    case = vc.case
+    t0 = time.perf_counter()
+    m = material(case)
+    las = case.lasers[0]
+    sim = simulation(vc)
+    run_to(sim, case.time.end_s)
+    x = sim.state.points.x.to_numpy()
+    rise = _point_T_C(sim) - case.thermal.initial_C
+    top = x[:, 1] >= x[:, 1].max() - 1e-12
+    r0, eta = las.spot_radius_um * 1e-6, las.penetration_depth_um * 1e-6
+    radius = np.hypot(x[:, 0] - las.x_start_um * 1e-6, x[:, 2] - las.z_start_um * 1e-6)
+    near = top & (radius <= r0)
+    y_l = case.top_um() * 1e-6
+    rho_c = m.density_kg_m3 * m.heat_capacity_solid_J_kgK
+
+    def exact(r: float, y: float) -> float:
+        return ref.gaussian_spot_halfspace(
+            r,
+            y_l - y,
+            sim.t,
+            las.depth_factor * las.absorptivity * las.power_W,
+            r0,
+            eta,
+            y_l - case.bodies[0].min_um[1] * 1e-6,
+            m.conductivity_solid_W_mK,
+            rho_c,
+        )
+
+    axis = exact(0.0, y_l)
+    errors = np.array([rise[p] - exact(radius[p], x[p, 1]) for p in np.flatnonzero(near)])
+    closest = radius[near] <= radius[near].min() + 1e-12
+    return result(
+        case,
+        sim,
+        {
+            "centre": float(errors[closest].mean() / axis),
+            "surface_max": float(np.abs(errors).max() / axis),
+        },
+        t0,
+        rise_axis_K=axis,
     )

@@ -35,6 +35,7 @@ Kind = Literal[
     "finite_strain",
     "erf",
     "gaussian",
+    "spot3d",
     "stefan",
     "energy",
     "curvature",
@@ -141,6 +142,11 @@ def _check(case: Case, v: VerificationSpec) -> None:
         need("sigma_um", v.sigma_um, "the initial width")
         if not case.physics.thermal:
             raise CaseError("verification.kind = 'gaussian': needs physics.thermal = true")
+    elif v.kind == "spot3d":
+        if case.domain.dim != 3 or len(case.lasers) != 1 or case.lasers[0].speed_m_s != 0.0:
+            raise CaseError(
+                "verification.kind = 'spot3d': needs domain.dim = 3 and one stationary laser"
+            )
     elif v.kind in ("perzyna", "finite_strain"):
         need("shear_rate_1_s", v.shear_rate_1_s, "the constant-rate drive")
         need("hold_strain", v.hold_strain, "the relaxation check")
