@@ -60,12 +60,7 @@ def _refuse_in_3d(case: Any) -> None:
     if ph.surface_tension and ph.mechanics and st.method == "csf":
         raise CaseError(
             'surface_tension.method = "csf" with domain.dim = 3: the paper\'s level-set CSF is '
-            "2D only; allowed in 3D: physics.surface_tension = false"
-        )
-    if ph.surface_tension and ph.mechanics:
-        raise CaseError(
-            "physics.surface_tension = true with domain.dim = 3: the surface-energy force (a "
-            f"marching-squares contour) is {not_yet}; allowed in 3D: false"
+            '2D only; allowed in 3D: "surface_energy" (or physics.surface_tension = false)'
         )
     for i, b in enumerate(case.bodies):
         if b.shape == "polygon":
