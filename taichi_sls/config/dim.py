@@ -73,11 +73,6 @@ def _refuse_in_3d(case: Any) -> None:
                 f'bodies[{i}].shape = "points" with domain.dim = 3: layer files are {not_yet}; '
                 'allowed in 3D: "disc" (a sphere), "rect" (a box)'
             )
-        if b.shape == "disc" and b.perturbation != 0.0:
-            raise CaseError(
-                f"bodies[{i}].perturbation = {b.perturbation} with domain.dim = 3: a shape mode "
-                f"of a sphere is {not_yet}; allowed in 3D: 0"
-            )
     if case.grid.seeding == "area":
         raise CaseError(
             f'grid.seeding = "area" with domain.dim = 3: area seeding is {not_yet}; allowed in '

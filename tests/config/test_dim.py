@@ -101,7 +101,6 @@ REFUSED_IN_3D = [
     ({"output": {"png": True}}, "output.png = true"),
     ({"output": {"vtu": True}}, "output.vtu = true"),
     ({"grid": {"seeding": "area"}}, 'grid.seeding = "area"'),
-    ({"bodies": [{"center_um": [20.0, 20.0, 16.0], "perturbation": 0.1}]}, "perturbation = 0.1"),
 ]
 
 
