@@ -165,3 +165,14 @@ def test_3d_capillary_stiffness_is_the_surface_laplacian():
     work = (V * f).sum()
     assert quad == pytest.approx(-work / gamma, rel=1e-10)
     assert quad > 0.0
+
+
+@pytest.mark.slow
+def test_l2_period_of_a_sphere_R_h_10():
+    """The l = 2 mode of a nearly inviscid sphere (cases/verification/inviscid3d.toml, eps0 =
+    0.05, eta_N = 1e-4 Pa s) oscillates with Rayleigh's period 2 pi / omega, omega^2 =
+    8 gamma / (rho R^3) (33.3 us), within 2 % at R/h = 10 (the issue's bound; measured +1.72 %,
+    beside the 2D disc's +1.23 % at the same R/h; 27 minutes on two loaded cores)."""
+    r = ver.run(ver.load("inviscid3d", 10))
+    print("l = 2 period, R/h = 10:", r.errors, r.info)
+    assert abs(r.errors["period"]) < 0.02
