@@ -176,3 +176,24 @@ def test_l2_period_of_a_sphere_R_h_10():
     r = ver.run(ver.load("inviscid3d", 10))
     print("l = 2 period, R/h = 10:", r.errors, r.info)
     assert abs(r.errors["period"]) < 0.02
+
+
+def test_a_perturbed_sphere_starts_to_round_off_and_keeps_its_momentum():
+    """The force in the explicit step: the l = 2 sphere of inviscid3d at R/h = 4 (seeded
+    eps = 0.0539 on the coarse staircase) for 40 steps (1.2 us of its 33 us period): the mode's
+    amplitude falls (measured to 0.0506) while the momentum stays at round-off (the force has
+    no resultant; the spread floor keeps it): measured 2.7e-15 of the mass times the largest
+    speed, bound 1e-12. The mass cut-off is off here: with the default (solver.small_mass) the
+    nodes below it, at the edge where the surface force acts, drop theirs (measured 1.1e-8)."""
+    sets = {"solver": {"optimize": False, "small_mass": 0.0}}
+    sim = Simulation(ver.load("inviscid3d", 4, sets).case)
+    st = sim.state
+    eps0 = mode_amplitude_3d(st.points.x.to_numpy(), st.points.volume0.to_numpy(), 2)
+    sim.advance(40)
+    x, v = st.points.x.to_numpy(), st.points.v.to_numpy()
+    m = st.points.mass.to_numpy()
+    eps = mode_amplitude_3d(x, st.points.volume0.to_numpy() * st.points.J.to_numpy(), 2)
+    print(f"eps {eps0:.5f} -> {eps:.5f}")
+    assert eps < eps0 - 1e-3
+    P = (m[:, None] * v).sum(axis=0)
+    assert np.abs(P).max() < 1e-12 * m.sum() * np.abs(v).max()
