@@ -35,7 +35,8 @@ class Disc(BodyBase):
         0.0,
         gt=-0.5,
         lt=0.5,
-        description="outline r = R (1 + perturbation cos(mode theta)), |value| < 0.5",
+        description="outline r = R (1 + perturbation cos(mode theta)), |value| < 0.5; a sphere: "
+        "r = R (1 + perturbation P_mode(cos theta)), theta from the x axis (Legendre P)",
     )
     mode: int = Field(2, ge=2, description="shape mode n >= 2 of the perturbation")
 

@@ -96,12 +96,7 @@ def _refuse_in_3d(case: Any) -> None:
     if ph.surface_tension and ph.mechanics and st.method == "csf":
         raise CaseError(
             'surface_tension.method = "csf" with domain.dim = 3: the paper\'s level-set CSF is '
-            "2D only; allowed in 3D: physics.surface_tension = false"
-        )
-    if ph.surface_tension and ph.mechanics:
-        raise CaseError(
-            "physics.surface_tension = true with domain.dim = 3: the surface-energy force (a "
-            f"marching-squares contour) is {not_yet}; allowed in 3D: false"
+            '2D only; allowed in 3D: "surface_energy" (or physics.surface_tension = false)'
         )
     for i, b in enumerate(case.bodies):
         if b.shape == "polygon":
@@ -113,11 +108,6 @@ def _refuse_in_3d(case: Any) -> None:
             raise CaseError(
                 f'bodies[{i}].shape = "points" with domain.dim = 3: layer files are {not_yet}; '
                 'allowed in 3D: "disc" (a sphere), "rect" (a box)'
-            )
-        if b.shape == "disc" and b.perturbation != 0.0:
-            raise CaseError(
-                f"bodies[{i}].perturbation = {b.perturbation} with domain.dim = 3: a shape mode "
-                f"of a sphere is {not_yet}; allowed in 3D: 0"
             )
     if case.grid.seeding == "area":
         raise CaseError(

@@ -36,19 +36,20 @@ class SurfaceTension(Model):
     surface_energy_colour_filter: bool = Field(
         True,
         description="surface_energy: contour the colour after one [1 2 1] / 4 pass along x and "
-        "y; without it a pair whose mid-plane lies on a node line keeps a one-cell notch at the "
-        "neck (the points of the two bodies never cross it)",
+        "y (and z in 3D); without it a pair whose mid-plane lies on a node line keeps a "
+        "one-cell notch at the neck (the points of the two bodies never cross it)",
     )
     surface_energy_weight: Literal["hat", "gimp"] = Field(
         "hat",
-        description="surface_energy: grad N_i at the Gauss points: hat (bilinear, the segment's "
-        "cell corners) or gimp (the solver's uGIMP)",
+        description="surface_energy: grad N_i at the Gauss points: hat (bi/trilinear, the "
+        "segment's or triangle's cell corners) or gimp (the solver's uGIMP)",
     )
     surface_energy_gauss_points: int = Field(
         1,
         gt=0,
         le=3,
-        description="surface_energy: Gauss points per outline segment (1 is exact for the hat)",
+        description="surface_energy: Gauss points per outline segment (1 is exact for the hat); "
+        "3D triangles take the 3-point rule of degree 2 (exact for the trilinear hat)",
     )
     surface_energy_mass_floor: float = Field(
         0.01,

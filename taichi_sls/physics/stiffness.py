@@ -16,7 +16,9 @@ with mu_t the secant shear modulus of the return map and eta the solvent viscosi
 K^cap is the semi-implicit capillary stiffness of Baensch (2001) and Hysing (2006) on the
 surface-energy outline, the surface Laplacian gamma sum_q w_q L_q (t . grad N_i)(t . grad N_j) 1
 over the Gauss points of its segments (physics/surface_energy.py): the force at x^n + dt v to
-first order, which lifts the capillary step limit.
+first order, which lifts the capillary step limit. In 3D the same on the triangles of the
+marching-tetrahedra surface, (P grad N_i) . (P grad N_j) with P = I - n n^T (the implicit
+integrators themselves are 2D only so far: config/dim.py).
 
 A point couples the nodes of its 3^dim stencil, so node i's row holds the 5^dim nodes within two
 of it: the matrix lives on the grid as ``K[I, I_j - I_i + 2, a, b]`` and solver/implicit.py
@@ -27,7 +29,7 @@ from taichi_sls.backend import ti
 
 from .shape import node_weight, stencil
 from .small_matrix import ZERO_MATRIX
-from .surface_energy import GAUSS, outline_segments
+from .surface_energy import GAUSS, outline_segments, outline_triangles
 
 REACH = 2  # nodes of one row lie within REACH of the diagonal node along every axis
 WIDTH = 2 * REACH + 1
@@ -121,8 +123,38 @@ def segment_tangent(cfg: ti.template(), K: ti.template(), a, b, scale):
 
 
 @ti.func
+def triangle_tangent(cfg: ti.template(), K: ti.template(), a, b, c, scale):
+    """K_ij += scale w_q A (P grad N_i) . (P grad N_j) 1, P = I - n n^T, over the three points of
+    triangle abc (physics/surface_energy.py, triangle_force): the surface Laplacian in 3D."""
+    nrm = (b - a).cross(c - a)
+    A2 = nrm.norm()
+    if A2 > 0.0:
+        n = nrm / A2
+        kq = scale * A2 / 6.0  # scale w_q A, w_q = 1/3
+        mid = (a + b + c) / 6.0
+        for q in range(3):
+            xq = mid + 0.5 * ti.select(q == 0, a, ti.select(q == 1, b, c))
+            base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
+            G = stencil_gradients(w, dw)
+            Gs = G - (G @ n).outer_product(n)  # the tangential gradients P grad N, by row
+            for i in range(3**cfg.dim):
+                oi = stencil_offset(i, cfg.dim)
+                for j in range(3**cfg.dim):
+                    gg = 0.0
+                    for e in ti.static(range(cfg.dim)):
+                        gg += Gs[i, e] * Gs[j, e]
+                    if gg != 0.0:
+                        off = stencil_offset(j, cfg.dim) - oi + REACH
+                        for e in ti.static(range(cfg.dim)):
+                            K[base + oi, off, e, e] += kq * gg
+
+
+@ti.func
 def capillary_tangent(
     cfg: ti.template(), box: ti.template(), nd: ti.template(), K: ti.template(), scale
 ):
     """The capillary stiffness of the outline of nd.colour (the force computed it before)."""
-    outline_segments(cfg, box, nd, segment_tangent, K, scale)
+    if ti.static(cfg.dim == 3):
+        outline_triangles(cfg, box, nd, triangle_tangent, K, scale)
+    else:
+        outline_segments(cfg, box, nd, segment_tangent, K, scale)

@@ -28,6 +28,11 @@ The surface energy of the bodies is gamma times the length of their outline. On 
    hands the rest to its 3x3 neighbours in proportion to their mass (``floor_mode = "spread"``,
    momentum kept) or drops it (``"clip"``). The other forces are untouched.
 
+In 3D (``domain.dim = 3``) the energy is gamma times the area: the filter runs along z too, the
+surface is cut by marching tetrahedra (physics/tetra.py), the force is taken at three points
+of each triangle with (I - n n^T) (:func:`triangle_force`) and the floor spreads to the 3x3x3
+neighbours. The 2D code path is kept as it was, bit for bit.
+
 Arguments: ``cfg`` (its ``se`` holds this method's switches), ``box`` the active region, ``nd``
 the nodes (``mass``, ``volume``, ``colour``, ``surface_force``, and ``force`` that it adds to).
 """
@@ -39,7 +44,8 @@ from taichi_sls.backend import ti
 from .contour import cell_segments
 from .grid import active, ramped_gamma, scatter_add
 from .shape import STENCIL_SHAPE, node_weight, stencil
-from .small_matrix import ZERO_VECTOR
+from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
+from .tetra import tet_corner, tet_triangles
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
 
@@ -76,7 +82,16 @@ def raw_colour(cfg: ti.template(), nd: ti.template(), I):
 
 @ti.func
 def colour_field(cfg: ti.template(), box: ti.template(), nd: ti.template()):
-    """nd.colour: the colour that is contoured, c_i or its [1 2 1]/4 filter along x and y."""
+    """nd.colour: the colour that is contoured, c_i or its [1 2 1]/4 filter along x and y (3D:
+    and z)."""
+    if ti.static(cfg.dim == 3):
+        _colour_field_3d(cfg, box, nd)
+    else:
+        _colour_field_2d(cfg, box, nd)
+
+
+@ti.func
+def _colour_field_2d(cfg: ti.template(), box: ti.template(), nd: ti.template()):
     for i, j in ti.ndrange(*active(box)):
         c = 0.0
         if ti.static(cfg.se.filter):
@@ -87,6 +102,23 @@ def colour_field(cfg: ti.template(), box: ti.template(), nd: ti.template()):
         else:
             c = raw_colour(cfg, nd, ti.Vector([i, j]))
         nd.colour[i, j] = c
+
+
+@ti.func
+def _colour_field_3d(cfg: ti.template(), box: ti.template(), nd: ti.template()):
+    n = ti.Vector([cfg.nx, cfg.ny, cfg.nz])
+    for I in ti.grouped(ti.ndrange(*active(box))):
+        c = 0.0
+        if ti.static(cfg.se.filter):
+            if (I > 0).all() and (I < n - 1).all():
+                for o in ti.grouped(ti.ndrange(3, 3, 3)):  # at run time: one copy of the body
+                    wo = 1.0
+                    for d in range(3):
+                        wo *= 0.5 - 0.25 * ti.abs(o[d] - 1)
+                    c += wo * raw_colour(cfg, nd, I + o - 1)
+        else:
+            c = raw_colour(cfg, nd, I)
+        nd.colour[I] = c
 
 
 @ti.func
@@ -225,12 +257,117 @@ def _cell_outline(visit):
 
 
 @ti.func
+def surface_force_add(cfg: ti.template(), nd: ti.template(), I, f):
+    """Node I's share f of the surface force: kept apart for the spread floor, scaled by
+    m_i / max(m_i, floor) for the clip floor, added to nd.force without a floor."""
+    if ti.static(cfg.se.spread):
+        scatter_add(cfg, nd.surface_force, I, f)
+    elif ti.static(cfg.se.floor_mass > 0.0):
+        m = nd.mass[I]
+        scatter_add(cfg, nd.force, I, (m / ti.max(m, cfg.se.floor_mass)) * f)
+    else:
+        scatter_add(cfg, nd.force, I, f)
+
+
+@ti.func
+def triangle_force(cfg: ti.template(), nd: ti.template(), a, b, c, gamma):
+    """f_i += -gamma A / 3 (I - n n^T) grad N_i(x_q) over the three points x_q = (2/3, 1/6, 1/6)
+    in barycentric coordinates of triangle abc (weights 1/3: exact to degree 2). The triangle
+    lies in one cell, where the trilinear hat's grad N is bilinear, so degree 2 on the plane of
+    the triangle: the rule is exact for the hat (``surface_energy_gauss_points`` is the 2D
+    segments' count)."""
+    nrm = (b - a).cross(c - a)
+    A2 = nrm.norm()
+    if A2 > 0.0:
+        n = nrm / A2
+        fq = -gamma * A2 / 6.0  # -gamma w_q A with A = |nrm| / 2, w_q = 1/3
+        mid = (a + b + c) / 6.0
+        for q in range(3):  # at run time: one copy of the stencil loop
+            xq = mid + 0.5 * ti.select(q == 0, a, ti.select(q == 1, b, c))
+            base, w, dw = stencil(xq, cfg.inv_h, cfg.h, cfg.se.weight_lp, cfg.off)
+            for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
+                N, gN = node_weight(w, dw, o)
+                g = gN - n.dot(gN) * n
+                if g.norm_sqr() != 0.0:
+                    surface_force_add(cfg, nd, base + o, fq * g)
+
+
+@ti.func
+def outline_triangles(
+    cfg: ti.template(),
+    box: ti.template(),
+    nd: ti.template(),
+    visit: ti.template(),
+    target: ti.template(),
+    scale,
+):
+    """visit(cfg, target, a, b, c, scale) for every triangle abc of the c = 1/2 surface of
+    nd.colour, cube by cube (marching tetrahedra, physics/tetra.py). One loop over the cubes
+    with atomic adds: the 3D layouts are not race free (config/dim.py refuses blocks)."""
+    ti.static_assert(not cfg.race_free, "3D surface force: atomic adds only")
+    n = ti.Vector([cfg.nx, cfg.ny, cfg.nz])
+    for I in ti.grouped(ti.ndrange(*active(box, 1))):
+        if (I > 0).all() and (I < n - 2).all():
+            lo, hi = 1.0, -1.0
+            for o in ti.grouped(ti.ndrange(2, 2, 2)):
+                fo = C_INTERFACE - nd.colour[I + o]
+                lo = ti.min(lo, fo)
+                hi = ti.max(hi, fo)
+            if hi >= 0.0 and lo < 0.0:
+                x0 = ti.cast(I - cfg.off, float) * cfg.h
+                for t in range(6):
+                    f = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                    p = ti.Matrix(ZERO_MATRIX[4, 3])
+                    for k in range(4):
+                        o = tet_corner(t, k)
+                        f[k] = C_INTERFACE - nd.colour[I + o]
+                        for d in range(3):
+                            p[k, d] = x0[d] + cfg.h * o[d]
+                    count, tri = tet_triangles(f, p)
+                    for q in range(count):
+                        a = ti.Vector([tri[3 * q, 0], tri[3 * q, 1], tri[3 * q, 2]])
+                        b = ti.Vector([tri[3 * q + 1, 0], tri[3 * q + 1, 1], tri[3 * q + 1, 2]])
+                        c = ti.Vector([tri[3 * q + 2, 0], tri[3 * q + 2, 1], tri[3 * q + 2, 2]])
+                        visit(cfg, target, a, b, c, scale)
+
+
+@ti.func
+def _spread_node_3d(cfg: ti.template(), nd: ti.template(), I):
+    """:func:`_spread_node` in 3D: the rest to the 26 neighbours, by mass."""
+    f = nd.surface_force[I]
+    m = nd.mass[I]
+    if m >= cfg.se.floor_mass:
+        scatter_add(cfg, nd.force, I, f)
+    elif f.norm_sqr() > 0.0:
+        M = 0.0
+        for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2), (-1, 2))):
+            if (o != 0).any():
+                M += nd.mass[I + o]
+        keep = m / cfg.se.floor_mass
+        if M <= 0.0:
+            keep = 1.0
+        scatter_add(cfg, nd.force, I, keep * f)
+        if M > 0.0:
+            rest = (1.0 - keep) / M * f
+            for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2), (-1, 2))):
+                if (o != 0).any():
+                    scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
+
+
+@ti.func
 def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), t):
     """The outline of the colour field and its surface-energy force, added to nd.force."""
     if ti.static(cfg.se.spread):
         for I in ti.grouped(ti.ndrange(*active(box))):
-            nd.surface_force[I] = ti.Vector(ZERO_VECTOR[2])
+            nd.surface_force[I] = ti.Vector(ZERO_VECTOR[cfg.dim])
     colour_field(cfg, box, nd)
-    outline_segments(cfg, box, nd, segment_force, nd, ramped_gamma(cfg, t))
+    if ti.static(cfg.dim == 3):
+        outline_triangles(cfg, box, nd, triangle_force, nd, ramped_gamma(cfg, t))
+    else:
+        outline_segments(cfg, box, nd, segment_force, nd, ramped_gamma(cfg, t))
     if ti.static(cfg.se.spread):
-        spread_light_nodes(cfg, box, nd)
+        if ti.static(cfg.dim == 3):
+            for I in ti.grouped(ti.ndrange(*active(box))):
+                _spread_node_3d(cfg, nd, I)
+        else:
+            spread_light_nodes(cfg, box, nd)

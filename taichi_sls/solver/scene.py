@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.polynomial import legendre
 
 from ..config import Case, CaseError
 from .contacts import fillet, in_bridge
@@ -87,11 +88,19 @@ def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
 
 def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
     """The body whose inside holds each candidate point (N, 3) (-1: none), the first that
-    does: a sphere (a disc with a 3D centre) or a box (a rect with 3D corners)."""
+    does: a sphere (a disc with a 3D centre; with a perturbation, its axisymmetric shape mode
+    P_n(cos theta) about x, the 2D mode cos(n theta)'s counterpart) or a box (a rect with 3D
+    corners)."""
     owner = np.full(len(P), -1, dtype=np.int64)
     for bi, b in enumerate(case.bodies):
         if b.shape == "disc":
-            inside = ((P - np.asarray(b.center_um)) ** 2).sum(axis=1) < b.radius_um**2
+            d = P - np.asarray(b.center_um)
+            r2 = (d**2).sum(axis=1)
+            R = b.radius_um
+            if b.perturbation:  # r < R (1 + eps P_n(cos theta)), theta from the x axis
+                cos = d[:, 0] / np.sqrt(np.maximum(r2, 1e-300))
+                R = R * (1.0 + b.perturbation * legendre.legval(cos, [0.0] * b.mode + [1.0]))
+            inside = r2 < R**2
         else:
             inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
         owner[(owner == -1) & inside] = bi

@@ -58,6 +58,7 @@ class Study:
     f32_at: tuple[float, ...] = ()
     csf_at: tuple[float, ...] = ()  # capillary cases: the paper's CSF beside the default force
     case: str = ""  # the verification case file (default: the name)
+    on_request: bool = False  # run only when --only names it (the 3D cases: tens of minutes)
 
     @property
     def file(self) -> str:
@@ -114,6 +115,8 @@ STUDIES = (
     ),
     Study("hopper_shape", (10, 20), (), "neck_tau1"),
     Study("hopper_pa12", (10, 20), (10,), "neck_tau1"),  # the implicit integrator's
+    Study("laplace3d", (10,), (10,), "pressure", on_request=True),
+    Study("inviscid3d", (10,), (10,), "period", on_request=True),
 )
 
 
@@ -143,7 +146,7 @@ def run_study(quick: bool, out: Path, only: list[str] | None = None) -> list[dic
         w = csv.DictWriter(fh, fieldnames=COLUMNS)
         w.writeheader()
         for s in STUDIES:
-            if only and s.name not in only:
+            if (only or s.on_request) and s.name not in (only or ()):
                 continue
             kind = ver.load(s.file).spec.kind
             res_list = s.quick if quick else s.resolutions

@@ -67,6 +67,12 @@ def test_coordinates_match_the_dimension():
     assert "z 15.0..35.0 um lies outside the domain 0..40.0 x 0..40.0 x 0..32.0 um" in _error(deep)
 
 
+def test_surface_energy_loads_in_3d():
+    """The surface-energy force runs in 3D (marching tetrahedra); only the CSF is refused."""
+    case = case_from_dict(deep_update(SPHERE, {"physics": {"surface_tension": True}}))
+    assert case.physics.surface_tension and case.surface_tension.method == "surface_energy"
+
+
 def test_3d_keys_are_refused_in_2d():
     front = deep_update(PAPER_SCENE, {"boundary": {"front": {"thermal": "fixed"}}})
     assert _error(front).startswith("boundary.front: a wall in z, 3D only")
@@ -75,7 +81,6 @@ def test_3d_keys_are_refused_in_2d():
 
 
 REFUSED_IN_3D = [
-    ({"physics": {"surface_tension": True}}, "physics.surface_tension = true"),
     (
         {"physics": {"surface_tension": True}, "surface_tension": {"method": "csf"}},
         "the paper's level-set CSF is 2D only",
@@ -96,7 +101,6 @@ REFUSED_IN_3D = [
     ({"output": {"png": True}}, "output.png = true"),
     ({"output": {"vtu": True}}, "output.vtu = true"),
     ({"grid": {"seeding": "area"}}, 'grid.seeding = "area"'),
-    ({"bodies": [{"center_um": [20.0, 20.0, 16.0], "perturbation": 0.1}]}, "perturbation = 0.1"),
 ]
 
 

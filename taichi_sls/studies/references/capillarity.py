@@ -1,4 +1,5 @@
-"""Capillarity of a 2D disc (cylinder): Laplace pressure, viscous and inviscid shape modes."""
+"""Capillarity of a 2D disc (cylinder): Laplace pressure, viscous and inviscid shape modes; the
+sphere's Laplace pressure and inviscid shape modes."""
 
 from __future__ import annotations
 
@@ -17,6 +18,12 @@ def laplace_pressure_2d(gamma: float, R: float) -> float:
     Quere 2004, Capillarity and Wetting Phenomena, ch. 1).
     """
     return gamma / R
+
+
+def laplace_pressure_3d(gamma: float, R: float) -> float:
+    """Young-Laplace pressure jump of a sphere (two principal curvatures 1/R): dp = 2 gamma/R
+    (Pa; same source)."""
+    return 2.0 * gamma / R
 
 
 def viscous_decay_rate(n: int, gamma: float, eta_N: float, R: float) -> float:
@@ -61,3 +68,12 @@ def inviscid_drop_omega(n: int, gamma: float, rho: float, R: float) -> float:
     Source: Rayleigh 1879 (Proc. R. Soc. 29, capillary jets); Lamb 1932, Hydrodynamics, sec. 275.
     """
     return math.sqrt(n * (n * n - 1) * gamma / (rho * R**3))
+
+
+def inviscid_sphere_omega(n: int, gamma: float, rho: float, R: float) -> float:
+    """Angular frequency of shape mode n (Legendre P_n) of an inviscid sphere (no outer fluid).
+
+    omega^2 = n (n - 1) (n + 2) gamma / (rho R^3); n = 2: 8 gamma / (rho R^3).
+    Source: Rayleigh 1879 (Proc. R. Soc. 29, 71-97); Lamb 1932, Hydrodynamics, sec. 275.
+    """
+    return math.sqrt(n * (n - 1) * (n + 2) * gamma / (rho * R**3))

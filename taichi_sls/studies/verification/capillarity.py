@@ -7,6 +7,7 @@ import math
 import time
 
 import numpy as np
+from numpy.polynomial import legendre
 
 from ...config import CaseError, Material
 from .. import references as ref
@@ -43,9 +44,23 @@ def eta_newtonian(m: Material) -> float:
 
 
 def _mode_amplitude(st, n: int) -> float:
-    return mode_amplitude(
+    amplitude = mode_amplitude_3d if st.cfg.dim == 3 else mode_amplitude
+    return amplitude(
         st.points.x.to_numpy(), st.points.volume0.to_numpy() * st.points.J.to_numpy(), n
     )
+
+
+def mode_amplitude_3d(x: np.ndarray, V: np.ndarray, n: int) -> float:
+    """eps_n of r = R(1 + eps P_n(cos theta)), theta from the x axis, from points x (N, 3) of
+    volumes V: the integral of the solid harmonic r^n P_n(cos theta) over the body is
+    4 pi R^(n+3) eps / (2n + 1) to first order, taken about the volume centroid with
+    R^3 = 3 V / (4 pi)."""
+    d = x - (V[:, None] * x).sum(axis=0) / V.sum()
+    r = np.linalg.norm(d, axis=1)
+    cos = d[:, 0] / np.maximum(r, 1e-300)
+    harmonic = r**n * legendre.legval(cos, [0.0] * n + [1.0])
+    R3 = 3.0 * V.sum() / (4.0 * np.pi)
+    return float((2 * n + 1) * (V * harmonic).sum() / (4.0 * np.pi * R3 ** (n / 3 + 1)))
 
 
 def mode_amplitude(x: np.ndarray, V: np.ndarray, n: int) -> float:
@@ -57,16 +72,37 @@ def mode_amplitude(x: np.ndarray, V: np.ndarray, n: int) -> float:
     return float((V * (z**n).real).sum() / (np.pi * R2 ** (n / 2 + 1)))
 
 
+def _laplace(dim: int, gamma: float, R: float) -> float:
+    return ref.laplace_pressure_3d(gamma, R) if dim == 3 else ref.laplace_pressure_2d(gamma, R)
+
+
+def hemisphere_pressure(sim) -> np.ndarray:
+    """The Laplace pressure that the surface force of a sphere carries, per axis a: the force
+    on the nodes above the plane through the points' centroid normal to a (the upper
+    hemisphere's share; the surface force alone: no stress, no gravity, ``surface_only`` run
+    first) over the hemisphere's section pi R^2, R the seeded radius. The force on a cap cut
+    off by that plane is the surface tension's pull along its rim, 2 pi R gamma, so the
+    pressure is 2 gamma / R (to the smoothing of the node set's edge, O((h/R)^2))."""
+    st = sim.state
+    f = st.nodes.force.to_numpy()
+    X = (np.indices(f.shape[:3]).transpose(1, 2, 3, 0) - st.cfg.off) * st.cfg.h
+    xc = st.points.x.to_numpy().mean(axis=0)
+    R = sim.case.bodies[0].radius_um * 1e-6
+    return np.array([-f[..., a][X[..., a] > xc[a]].sum() / (np.pi * R * R) for a in range(3)])
+
+
 def run_laplace(vc: VerificationCase) -> Result:
     """A disc at rest under surface tension: mean in-plane pressure -(s_xx + s_yy)/2 of the inner
     half against gamma/R, averaged over the last 40 % of the run; spurious velocity as a
-    capillary number eta_N |v|max / gamma (a fluid disc) and against sqrt(gamma/(rho R))."""
+    capillary number eta_N |v|max / gamma (a fluid disc) and against sqrt(gamma/(rho R)). In 3D a
+    sphere: the mean pressure -tr(s)/3 against 2 gamma / R."""
     case = vc.case
     t0 = time.perf_counter()
     m = material(case)
     R = case.bodies[0].radius_um * 1e-6
     sim = simulation(vc)
     st = sim.state
+    dim = case.domain.dim
     run_to(sim, 0.6 * case.time.end_s)
     ps, vs = [], []
     for _ in range(8):
@@ -74,7 +110,10 @@ def run_laplace(vc: VerificationCase) -> Result:
         x = st.points.x.to_numpy()
         inner = np.linalg.norm(x - x.mean(axis=0), axis=1) < 0.5 * R
         sig = st.points.stress.to_numpy()
-        ps.append(np.mean(-0.5 * (sig[inner, 0, 0] + sig[inner, 1, 1])))
+        if dim == 3:
+            ps.append(np.mean(-(sig[inner, 0, 0] + sig[inner, 1, 1] + sig[inner, 2, 2]) / 3.0))
+        else:
+            ps.append(np.mean(-0.5 * (sig[inner, 0, 0] + sig[inner, 1, 1])))
         vs.append(np.linalg.norm(st.points.v.to_numpy(), axis=1).max())
     gamma = m.surface_tension_N_m
     curvature = math.nan  # the CSF's curvature at the end (the surface-energy force has none)
@@ -87,7 +126,7 @@ def run_laplace(vc: VerificationCase) -> Result:
         w *= (st.nodes.flags.to_numpy() & 2) > 0
         curvature = float((w * k).sum() / w.sum() * R - 1.0)
     errors = {
-        "pressure": float(np.mean(ps) / ref.laplace_pressure_2d(gamma, R) - 1.0),
+        "pressure": float(np.mean(ps) / _laplace(dim, gamma, R) - 1.0),
         "capillary_number": eta_newtonian(m) * max(vs) / gamma,
     }
     return result(
@@ -161,13 +200,15 @@ def run_viscous_decay(vc: VerificationCase) -> Result:
 def run_inviscid(vc: VerificationCase) -> Result:
     """Oscillating shape mode n of a nearly inviscid disc: the period from the zero crossings of
     eps(t) against 2 pi / omega, omega^2 = n(n^2 - 1) gamma/(rho R^3) (references.
-    inviscid_drop_omega); the amplitude lost per period is reported."""
+    inviscid_drop_omega; a sphere: n (n - 1)(n + 2), inviscid_sphere_omega); the amplitude lost
+    per period is reported."""
     case = vc.case
     t0 = time.perf_counter()
     m = material(case)
     b = case.bodies[0]
     R = b.radius_um * 1e-6
-    omega = ref.inviscid_drop_omega(b.mode, m.surface_tension_N_m, m.density_kg_m3, R)
+    drop = ref.inviscid_sphere_omega if case.domain.dim == 3 else ref.inviscid_drop_omega
+    omega = drop(b.mode, m.surface_tension_N_m, m.density_kg_m3, R)
     period = 2 * np.pi / omega
     sim, ts, eps = _mode_history(vc, max(40, int(80 * case.time.end_s / period)))
     s = np.sign(eps)

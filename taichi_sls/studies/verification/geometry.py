@@ -12,12 +12,16 @@ from .. import references as ref
 
 def disc_geometry(data: dict, R_over_h: float) -> None:
     """Disc of the case at R/h: domain 2R(1 + |eps|) + 12 h square, centre off the grid lines so
-    that the seeding is not symmetric about a node."""
+    that the seeding is not symmetric about a node (``domain.dim = 3``: a sphere in a cube)."""
     b = data["bodies"][0]
     R = b["radius_um"]
     h = R / R_over_h
     W = h * math.ceil((2 * R * (1 + abs(b.get("perturbation", 0.0))) + 12 * h) / h)
     data["grid"]["spacing_um"] = h
+    if data.get("domain", {}).get("dim", 2) == 3:  # a sphere in a cube
+        data["domain"] = {"dim": 3, "width_um": W, "height_um": W, "depth_um": W}
+        b["center_um"] = [W / 2 + 0.123 * h, W / 2 + 0.377 * h, W / 2 - 0.141 * h]
+        return
     data["domain"] = {"width_um": W, "height_um": W}
     b["center_um"] = [W / 2 + 0.123 * h, W / 2 + 0.377 * h]
 
