@@ -134,7 +134,7 @@ def plot(path: Path, beds: list, side: float) -> None:
         ylabel="y / d",
         title=f"core: {min(bulk):.3f}-{max(bulk):.3f} ({len(r)} spheres)",
     )
-    bx.legend(loc="lower left", fontsize=8)
+    bx.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
