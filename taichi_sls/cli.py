@@ -6,7 +6,7 @@
                      integrators side by side), hold (a melt that
                      sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
                      neck (the melted-pair study), refinement (the paper's cases under grid and
-                     dt refinement)
+                     dt refinement), packing3d (the 3D bed generator's packing fraction)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -133,6 +133,7 @@ def case_command(args: argparse.Namespace) -> int:
 def parser() -> argparse.ArgumentParser:
     from .studies import (
         accuracy,
+        bed3d_packing,
         compile_bench,
         cost_error,
         implicit_bench,
@@ -157,7 +158,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement",
+        "paper, neck, refinement, packing3d",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -171,6 +172,7 @@ def parser() -> argparse.ArgumentParser:
         paper,
         neck_study,
         refinement,
+        bed3d_packing,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)

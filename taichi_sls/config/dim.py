@@ -23,6 +23,11 @@ def check_dimension(case: Any) -> None:
                     f"boundary.{key}: a wall in z, 3D only (domain.dim = 2; allowed: left, "
                     "right, bottom, top)"
                 )
+        if case.bed is not None and case.bed.z_range_um is not None:
+            raise CaseError(
+                f"bed.z_range_um = {case.bed.z_range_um}: 3D only (domain.dim = 2 deposits "
+                "discs over bed.x_range_um)"
+            )
         if case.domain.depth_um is not None:
             raise CaseError(
                 f"domain.depth_um = {case.domain.depth_um}: 3D only (domain.dim = 2 is a plane "
@@ -114,9 +119,10 @@ def _refuse_in_3d(case: Any) -> None:
             f'grid.seeding = "area" with domain.dim = 3: area seeding is {not_yet}; allowed in '
             '3D: "centre"'
         )
-    if case.bed is not None:
+    if case.bed is not None and case.bed.previous_layer is not None:
         raise CaseError(
-            f"bed with domain.dim = 3: a generated bed is {not_yet}; allowed in 3D: [[bodies]]"
+            f"bed.previous_layer = {case.bed.previous_layer!r} with domain.dim = 3: layer files "
+            f"are {not_yet}; allowed in 3D: a generated bed or bed.csv of spheres"
         )
     if case.contact.initial == "fillet":
         raise CaseError(

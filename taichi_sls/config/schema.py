@@ -15,6 +15,7 @@ import numpy as np
 from pydantic import Field, PrivateAttr, model_validator
 
 from .bed import Bed, bed_discs
+from .bed3d import expand_bed_3d
 from .bodies import Body, Disc, LayerBody
 from .dim import check_dimension
 from .errors import CaseError
@@ -89,6 +90,9 @@ class Case(Model):
         is fitted to the bed: its x range, and its top plus one mean diameter, in whole cells."""
         bed = self.bed
         if bed is None:
+            return
+        if self.domain.dim == 3:
+            expand_bed_3d(self)
             return
         if bed.material not in self.materials:
             raise CaseError(

@@ -42,8 +42,9 @@ NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
 
 
 def is_bed(case: Case) -> bool:
-    """A case whose outcome is read per contact: more than two bodies."""
-    return len(case.bodies) > 2
+    """A case whose outcome is read per contact: more than two bodies, in 2D (the necks and
+    the layer's density read 2D sections of the colour; a 3D bed reports neither yet)."""
+    return len(case.bodies) > 2 and case.domain.dim == 2
 
 
 def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:

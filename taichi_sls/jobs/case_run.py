@@ -261,6 +261,13 @@ def run_case(
             solidified=solid and summary["status"] == "complete",
             baseline_um=baseline_um,
         )
+        if bed is None and len(case.bodies) > 2:  # 3D: the per-contact outputs are 2D only
+            summary["outcome"].update(
+                fused=None,
+                no_verdict=f"{len(case.bodies)} bodies in 3D: the per-contact verdict reads neck "
+                "sections, not built in 3D yet (issue #39)",
+            )
+            summary["bed_generator"] = case.bed_report()
         if bed is not None:
             summary["outcome"].update(
                 fused=None,

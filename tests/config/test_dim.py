@@ -89,7 +89,6 @@ REFUSED_IN_3D = [
         {"bodies": [{"shape": "polygon", "vertices_um": [[0, 0], [10, 0], [0, 10]]}]},
         'bodies[0].shape = "polygon"',
     ),
-    ({"bed": {"count": 2}, "bodies": []}, "bed with domain.dim = 3"),
     ({"contact": {"initial": "fillet"}}, 'contact.initial = "fillet"'),
     ({"contact": {"settle": True}}, "contact.settle = true"),
     ({"time": {"integrator": "implicit"}}, "time.integrator = 'implicit'"),
