@@ -6,7 +6,8 @@
                      integrators side by side), hold (a melt that
                      sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
                      neck (the melted-pair study), refinement (the paper's cases under grid and
-                     dt refinement)
+                     dt refinement), process (a PA12 layer's density against energy density and
+                     bed temperature, and its sensitivities)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -143,6 +144,7 @@ def parser() -> argparse.ArgumentParser:
         sinter_hold,
         speed,
     )
+    from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
 
     ap = argparse.ArgumentParser(
@@ -156,7 +158,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, accuracy, paper, "
-        "neck, refinement",
+        "neck, refinement, process",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -169,6 +171,7 @@ def parser() -> argparse.ArgumentParser:
         paper,
         neck_study,
         refinement,
+        process_study,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)

@@ -1,0 +1,74 @@
+"""What the three process sweeps say, read from their ``results.csv``: the density against the
+Andrew number, the bed temperature where densification stops, and the density's change for each
+uncertain input at the reference setting (:mod:`.design`)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from ..sweep.results import read_results
+
+INITIAL = "bed.relative_density.initial"
+FINAL = "bed.relative_density.final"
+# a bed temperature "densifies" when its gain is at least this share of the hottest bed's gain
+DENSIFIES_SHARE = 0.5
+
+
+def _done(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Complete rows with both densities, each with ``gain`` = final - initial."""
+    out = []
+    for r in rows:
+        if r.get("status") != "complete" or r.get(FINAL) in ("", None):
+            continue
+        out.append({**r, "gain": float(r[FINAL]) - float(r[INITIAL])})
+    return out
+
+
+def energy_summary(results_csv: str | Path) -> list[dict[str, Any]]:
+    """The energy sweep's complete rows by increasing Andrew number."""
+    rows = _done(read_results(results_csv))
+    return sorted(rows, key=lambda r: (r["andrew_J_mm2"], r["hatch_um"]))
+
+
+def bed_summary(results_csv: str | Path) -> dict[str, Any]:
+    """The bed-temperature rows by temperature and the threshold: the lowest bed temperature
+    above which every bed gains at least ``DENSIFIES_SHARE`` of the hottest bed's gain (NaN when
+    fewer than two rows finished)."""
+    rows = sorted(_done(read_results(results_csv)), key=lambda r: r["bed_C"])
+    threshold = math.nan
+    if len(rows) >= 2:
+        top = rows[-1]["gain"]
+        for r in reversed(rows):
+            if top > 0 and r["gain"] >= DENSIFIES_SHARE * top:
+                threshold = r["bed_C"]
+            else:
+                break
+    return {"rows": rows, "threshold_C": threshold, "share": DENSIFIES_SHARE}
+
+
+def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
+    """The reference's final density and, for each factor, the change of the final density at
+    its two levels (final - reference final); the ``layer time`` row as the plateau check."""
+    rows = _done(read_results(results_csv))
+    ref = next((r for r in rows if r["factor"] == "reference"), None)
+    if ref is None:
+        return {"reference": None, "factors": [], "plateau": None}
+    base = float(ref[FINAL])
+    factors: dict[str, dict[str, float]] = {}
+    plateau = None
+    for r in rows:
+        if r["factor"] == "reference":
+            continue
+        delta = float(r[FINAL]) - base
+        if r["factor"] == "layer time":
+            plateau = {"level": r["level"], "final": float(r[FINAL]), "change": delta}
+            continue
+        factors.setdefault(r["factor"], {})[str(r["level"])] = delta
+    ordered = sorted(factors.items(), key=lambda kv: -max(abs(v) for v in kv[1].values()))
+    return {
+        "reference": {"initial": float(ref[INITIAL]), "final": base, "gain": ref["gain"]},
+        "factors": [{"factor": k, "changes": v} for k, v in ordered],
+        "plateau": plateau,
+    }
