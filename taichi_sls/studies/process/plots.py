@@ -75,8 +75,16 @@ def plot_density_energy(
     for i, p in enumerate(measured):
         rel = p.relative_density
         if p.energy_J_mm2 is not None:
-            label = f"{p.label}: {p.process} ({p.kind})"
+            label = f"{p.label} ({p.kind})"
             ax.plot(p.energy_J_mm2, rel, "D", color=f"C{i + 1}", ms=7, label=label)
+            ax.annotate(
+                p.process,
+                (p.energy_J_mm2, rel),
+                xytext=(8, -3),
+                textcoords="offset points",
+                fontsize=8,
+                color=f"C{i + 1}",
+            )
         else:
             ax.axhline(rel, color=f"C{i + 1}", ls="--", lw=1)
             ax.text(
@@ -91,8 +99,16 @@ def plot_density_energy(
     ax.set_xlabel("Andrew number P / (v h) (J/mm$^2$)")
     ax.set_ylabel("relative density")
     ax.set_title("PA12 layer: relative density against energy density")
-    ax.legend(loc="center right", fontsize=8)
-    ax.text(0.04, 0.14, NOT_COMPARABLE, transform=ax.transAxes, fontsize=8, va="bottom")
+    ax.legend(loc="center", bbox_to_anchor=(0.5, 0.5), fontsize=8)
+    ax.text(
+        0.98,
+        0.16,
+        NOT_COMPARABLE,
+        transform=ax.transAxes,
+        fontsize=8,
+        ha="right",
+        multialignment="left",
+    )
     gx.set_xlim(0.0, 1.1 * e_max)
     gx.set_xlabel("Andrew number P / (v h) (J/mm$^2$)")
     gx.set_ylabel("density gained over the layer time (percentage points)")

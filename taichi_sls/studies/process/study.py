@@ -8,8 +8,10 @@ Dask sweep runner (docs/sweeps.md, "What a process engineer reads").
 Each study is a sweep (:mod:`.design`) whose rows go to ``OUT/<sweep>/results.csv`` as they
 finish (a rerun skips finished cases, as ``taichi-sls sweep`` does); then ``OUT/process.json``
 holds the summaries (:mod:`.summary`) and ``density_energy.png``, ``bed_temperature.png`` and
-``density_sensitivity.png`` are drawn into ``--figures`` (default OUT). ``--base`` names another
-hatched layer (another material, say): the sweeps scale that case's own inputs.
+``density_sensitivity.png`` are drawn into ``--figures`` (default OUT; another folder also
+gets the results tables as ``<sweep>.csv`` and the summaries as ``process_study.json``).
+``--base`` names another hatched layer (another material, say): the sweeps scale that case's
+own inputs.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shutil
 import sys
 from pathlib import Path
 from typing import Any
@@ -84,7 +87,13 @@ def report(out: Path, figures: Path, base: str, extra_set: list[str]) -> dict[st
             png = plots.plot_sensitivity(sens, figures / "density_sensitivity.png")
             result["figures"].append(str(png))
     out.mkdir(parents=True, exist_ok=True)
-    (out / "process.json").write_text(json.dumps(_clean(result), indent=1) + "\n")
+    text = json.dumps(_clean(result), indent=1) + "\n"
+    (out / "process.json").write_text(text)
+    if figures.resolve() != out.resolve():  # the tables beside the figures, for committing
+        for k, name in SWEEP_NAMES.items():
+            if csv[k].is_file():
+                shutil.copyfile(csv[k], figures / f"{name}.csv")
+        (figures / "process_study.json").write_text(text)
     return result
 
 

@@ -50,13 +50,16 @@ def bed_summary(results_csv: str | Path) -> dict[str, Any]:
 
 def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
     """The reference's final density and, for each factor, the change of the final density at
-    its two levels (final - reference final); the ``layer time`` row as the plateau check."""
+    its two levels (final - reference final) and of the density gained (a factor that moves the
+    settled powder's density moves the start too); the ``layer time`` row as the plateau
+    check."""
     rows = _done(read_results(results_csv))
     ref = next((r for r in rows if r["factor"] == "reference"), None)
     if ref is None:
         return {"reference": None, "factors": [], "plateau": None}
     base = float(ref[FINAL])
     factors: dict[str, dict[str, float]] = {}
+    gains: dict[str, dict[str, float]] = {}  # the change of the gain: the start moves too
     plateau = None
     for r in rows:
         if r["factor"] == "reference":
@@ -66,9 +69,10 @@ def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
             plateau = {"level": r["level"], "final": float(r[FINAL]), "change": delta}
             continue
         factors.setdefault(r["factor"], {})[str(r["level"])] = delta
+        gains.setdefault(r["factor"], {})[str(r["level"])] = r["gain"] - ref["gain"]
     ordered = sorted(factors.items(), key=lambda kv: -max(abs(v) for v in kv[1].values()))
     return {
         "reference": {"initial": float(ref[INITIAL]), "final": base, "gain": ref["gain"]},
-        "factors": [{"factor": k, "changes": v} for k, v in ordered],
+        "factors": [{"factor": k, "changes": v, "gain_changes": gains[k]} for k, v in ordered],
         "plateau": plateau,
     }
