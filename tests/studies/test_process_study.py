@@ -152,6 +152,7 @@ def _row(final: float, **params) -> dict:
         "bed.relative_density.final": final,
         "bed.fused_fraction": 0.0,
         "status": "complete",
+        "error": "",
     }
 
 
@@ -167,9 +168,16 @@ def test_bed_threshold_and_sensitivity_order(tmp_path):
         _row(0.840, factor="large", level="lo"),
         _row(0.853, factor="large", level="hi"),
         _row(0.8505, factor="layer time", level="10 s"),
+        {**_row(0.86, factor="odd", level="+20 %"), "status": "failed", "error": "J = 71.6"},
     ]
     sens = sensitivity_summary(_results(tmp_path / "s.csv", rows))
-    assert [f["factor"] for f in sens["factors"]] == ["large", "small"]
+    assert [f["factor"] for f in sens["factors"]] == ["large", "small", "odd"]
+    assert sens["factors"][2] == {
+        "factor": "odd",
+        "changes": {},
+        "gain_changes": {},
+        "failed": {"+20 %": "failed: J = 71.6"},
+    }
     assert sens["factors"][0]["changes"]["lo"] == pytest.approx(-0.010)
     assert sens["plateau"]["change"] == pytest.approx(0.0005)
     png = plots.plot_sensitivity(sens, tmp_path / "tornado.png")

@@ -12,6 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
 from .measured import MeasuredPoint  # noqa: E402
 
@@ -158,7 +159,8 @@ def plot_sensitivity(summary: dict[str, Any], png: str | Path) -> Path:
         y = len(facs) - 1 - i
         noise = f["factor"].startswith("another bed")
         for j, (level, d) in enumerate(f["changes"].items()):
-            color = "0.6" if noise else ("C0" if j == 0 else "C3")
+            lower = level.startswith(("-", "/"))  # the design's lower levels: /2, -20 %, -3 K
+            color = "0.6" if noise else ("C0" if lower else "C3")
             ax.barh(y, 100 * d, color=color, height=0.6, alpha=0.85)
             ax.text(
                 100 * d,
@@ -168,7 +170,22 @@ def plot_sensitivity(summary: dict[str, Any], png: str | Path) -> Path:
                 va="center",
                 ha="left" if d >= 0 else "right",
             )
+        for level in f.get("failed", {}):
+            ax.text(
+                0,
+                y + 0.18,
+                f" {level}: the run failed (process.json says why)",
+                fontsize=8,
+                va="center",
+                color="C3",
+            )
     ax.set_yticks(range(len(facs)), [f["factor"] for f in reversed(facs)])
+    handles = [
+        Patch(color="C0", label="lower level (/2, -20 %, -3 K)"),
+        Patch(color="C3", label="upper level (x2, +20 %, +3 K)"),
+        Patch(color="0.6", label="another bed draw: the noise"),
+    ]
+    ax.legend(handles=handles, fontsize=8, loc="lower right")
     ax.axvline(0, color="k", lw=0.8)
     ref = summary["reference"]
     title = "sensitivity of the layer's final relative density"

@@ -53,10 +53,15 @@ def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
     its two levels (final - reference final) and of the density gained (a factor that moves the
     settled powder's density moves the start too); the ``layer time`` row as the plateau
     check."""
-    rows = _done(read_results(results_csv))
+    every = read_results(results_csv)
+    rows = _done(every)
     ref = next((r for r in rows if r["factor"] == "reference"), None)
     if ref is None:
         return {"reference": None, "factors": [], "plateau": None}
+    failed: dict[str, dict[str, str]] = {}  # factor -> level -> the run's status and error
+    for r in every:
+        if r.get("status") not in ("complete", None) and r["factor"] not in ("reference",):
+            failed.setdefault(r["factor"], {})[str(r["level"])] = f"{r['status']}: {r['error']}"
     base = float(ref[FINAL])
     factors: dict[str, dict[str, float]] = {}
     gains: dict[str, dict[str, float]] = {}  # the change of the gain: the start moves too
@@ -70,9 +75,16 @@ def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
             continue
         factors.setdefault(r["factor"], {})[str(r["level"])] = delta
         gains.setdefault(r["factor"], {})[str(r["level"])] = r["gain"] - ref["gain"]
-    ordered = sorted(factors.items(), key=lambda kv: -max(abs(v) for v in kv[1].values()))
+    for k in failed:
+        factors.setdefault(k, {})
+        gains.setdefault(k, {})
+    ordered = sorted(factors.items(), key=lambda kv: -max([abs(v) for v in kv[1].values()] + [0]))
     return {
         "reference": {"initial": float(ref[INITIAL]), "final": base, "gain": ref["gain"]},
-        "factors": [{"factor": k, "changes": v, "gain_changes": gains[k]} for k, v in ordered],
+        "factors": [
+            {"factor": k, "changes": v, "gain_changes": gains[k], "failed": failed.get(k, {})}
+            for k, v in ordered
+            if k != "layer time"
+        ],
         "plateau": plateau,
     }
