@@ -150,30 +150,27 @@ def plot_bed_temperature(summary: dict[str, Any], marks: dict[str, Any], png: st
 
 
 def plot_sensitivity(summary: dict[str, Any], png: str | Path) -> Path:
-    """Tornado: the change of the final relative density (percentage points) for each factor's
-    two levels, largest first; another bed draw (seed) in grey as the noise to read them by."""
+    """Tornado: the change of the density gained over the layer time (percentage points) for
+    each factor's two levels, largest first; another bed draw (seed) in grey as the noise to
+    read them by."""
     fig = Figure(figsize=(9.0, 5.2), layout="constrained")
     ax = fig.subplots()
     facs = summary["factors"]
     for i, f in enumerate(facs):
         y = len(facs) - 1 - i
         noise = f["factor"].startswith("another bed")
-        for j, (level, d) in enumerate(f["changes"].items()):
+        for level, d in f["gain_changes"].items():
             lower = level.startswith(("-", "/"))  # the design's lower levels: /2, -20 %, -3 K
             color = "0.6" if noise else ("C0" if lower else "C3")
-            ax.barh(y, 100 * d, color=color, height=0.6, alpha=0.85)
-            ax.text(
-                100 * d,
-                y + (0.18 if j else -0.18),
-                f" {level} ",
-                fontsize=8,
-                va="center",
-                ha="left" if d >= 0 else "right",
-            )
+            yl = y - 0.17 if lower or (noise and level < max(f["gain_changes"])) else y + 0.17
+            ax.barh(yl, 100 * d, color=color, height=0.32)
+            ha = "left" if d >= 0 else "right"
+            ax.text(100 * d, yl, f" {level} ", fontsize=8, va="center", ha=ha)
         for level in f.get("failed", {}):
+            yl = y - 0.17 if level.startswith(("-", "/")) else y + 0.17
             ax.text(
                 0,
-                y + 0.18,
+                yl,
                 f" {level}: the run failed (process.json says why)",
                 fontsize=8,
                 va="center",
@@ -185,15 +182,18 @@ def plot_sensitivity(summary: dict[str, Any], png: str | Path) -> Path:
         Patch(color="C3", label="upper level (x2, +20 %, +3 K)"),
         Patch(color="0.6", label="another bed draw: the noise"),
     ]
-    ax.legend(handles=handles, fontsize=8, loc="lower right")
+    ax.legend(handles=handles, fontsize=8, loc="upper left")
     ax.axvline(0, color="k", lw=0.8)
     ref = summary["reference"]
-    title = "sensitivity of the layer's final relative density"
+    title = "sensitivity of the density a layer gains over its layer time"
     if ref:
-        title += f"\nreference {ref['final']:.4f} (gained {100 * ref['gain']:.2f} points)"
+        title += (
+            f"\nreference: {ref['initial']:.4f} -> {ref['final']:.4f}, gained "
+            f"{100 * ref['gain']:.2f} points"
+        )
     ax.set_title(title)
-    ax.set_xlabel("change of the final relative density (percentage points)")
+    ax.set_xlabel("change of the density gained (percentage points of relative density)")
     ax.grid(axis="x", alpha=0.3)
-    lim = max([abs(100 * d) for f in facs for d in f["changes"].values()] + [0.1])
+    lim = max([abs(100 * d) for f in facs for d in f["gain_changes"].values()] + [0.1])
     ax.set_xlim(-1.35 * lim, 1.35 * lim)
     return _save(fig, png)
