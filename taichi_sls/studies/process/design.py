@@ -13,6 +13,7 @@ the studies on another material.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -113,11 +114,13 @@ def _make(
 ) -> Sweep:
     """A Sweep of (params, overrides) pairs; ``common`` overrides come first in every case."""
     path = find_case(base).resolve()
-    sweep = Sweep(name=name, base=path, base_text=str(base), collect=COLLECT, keys=[])
+    # the ids hash the base's contents too: a base whose material changed reruns in the same OUT
+    text = f"{base}@{hashlib.sha1(path.read_bytes()).hexdigest()[:10]}"
+    sweep = Sweep(name=name, base=path, base_text=text, collect=COLLECT, keys=[])
     seen = set()
     for params, values in settings:
         overrides = list(common) + [f"{k}={toml_value(v)}" for k, v in values.items()]
-        cid = case_id(str(base), overrides)
+        cid = case_id(text, overrides)
         if cid in seen:
             continue
         seen.add(cid)

@@ -57,13 +57,21 @@ def _clean(v: Any) -> Any:
     return v
 
 
-def report(out: Path, figures: Path, base: str, extra_set: list[str]) -> dict[str, Any]:
-    """Summaries of whichever sweeps have results in ``out``, their figures drawn into
-    ``figures``; written to ``out/process.json`` and returned."""
+def report(
+    out: Path,
+    figures: Path,
+    base: str,
+    extra_set: list[str],
+    ids: dict[str, set[str]] | None = None,
+) -> dict[str, Any]:
+    """Summaries of whichever sweeps have results in ``out`` (of the cases ``ids[study]`` only,
+    when given), their figures drawn into ``figures``; written to ``out/process.json`` and
+    returned."""
+    ids = ids or {}
     result: dict[str, Any] = {"base": base, "set": extra_set, "figures": []}
     csv = {k: out / name / "results.csv" for k, name in SWEEP_NAMES.items()}
     if csv["energy"].is_file():
-        rows = summary.energy_summary(csv["energy"])
+        rows = summary.energy_summary(csv["energy"], ids.get("energy"))
         keep = ("power_W", "speed_m_s", "hatch_um", "andrew_J_mm2", summary.INITIAL)
         result["energy"] = [
             {k: r[k] for k in (*keep, summary.FINAL, "gain", "bed.fused_fraction")} for r in rows
@@ -71,7 +79,7 @@ def report(out: Path, figures: Path, base: str, extra_set: list[str]) -> dict[st
         png = plots.plot_density_energy(rows, load_measured(), figures / "density_energy.png")
         result["figures"].append(str(png))
     if csv["bed"].is_file():
-        bed = summary.bed_summary(csv["bed"])
+        bed = summary.bed_summary(csv["bed"], ids.get("bed"))
         result["bed_temperature"] = {
             "threshold_C": bed["threshold_C"],
             "rows": [{k: r[k] for k in ("bed_C", summary.FINAL, "gain")} for r in bed["rows"]],
@@ -81,7 +89,7 @@ def report(out: Path, figures: Path, base: str, extra_set: list[str]) -> dict[st
         )
         result["figures"].append(str(png))
     if csv["sensitivity"].is_file():
-        sens = summary.sensitivity_summary(csv["sensitivity"])
+        sens = summary.sensitivity_summary(csv["sensitivity"], ids.get("sensitivity"))
         result["sensitivity"] = sens
         if sens["reference"] is not None:
             png = plots.plot_sensitivity(sens, figures / "density_sensitivity.png")
@@ -131,6 +139,7 @@ def main(args: argparse.Namespace) -> int:
         return 2
     try:
         sweeps = [STUDIES[name](Path(args.base), extra) for name in args.only]
+        ids = {name: {c.id for c in sw.cases} for name, sw in zip(args.only, sweeps, strict=True)}
     except (SweepError, CaseError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -149,7 +158,7 @@ def main(args: argparse.Namespace) -> int:
                 print("interrupted; finished cases are in results.csv", file=sys.stderr)
                 return 130
     try:
-        result = report(out, figures, args.base, extra)
+        result = report(out, figures, args.base, extra, None if args.plot_only else ids)
     except MeasuredDataError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

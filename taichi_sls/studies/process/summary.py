@@ -16,6 +16,13 @@ FINAL = "bed.relative_density.final"
 DENSIFIES_SHARE = 0.5
 
 
+def _rows(results_csv: str | Path, ids: set[str] | None) -> list[dict[str, Any]]:
+    """The table's rows, only those of ``ids`` when given (a results.csv keeps the rows of cases
+    no longer swept, e.g. those of a base before its material changed)."""
+    rows = read_results(results_csv)
+    return rows if ids is None else [r for r in rows if r["id"] in ids]
+
+
 def _done(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Complete rows with both densities, each with ``gain`` = final - initial."""
     out = []
@@ -26,17 +33,17 @@ def _done(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def energy_summary(results_csv: str | Path) -> list[dict[str, Any]]:
+def energy_summary(results_csv: str | Path, ids: set[str] | None = None) -> list[dict[str, Any]]:
     """The energy sweep's complete rows by increasing Andrew number."""
-    rows = _done(read_results(results_csv))
+    rows = _done(_rows(results_csv, ids))
     return sorted(rows, key=lambda r: (r["andrew_J_mm2"], r["hatch_um"]))
 
 
-def bed_summary(results_csv: str | Path) -> dict[str, Any]:
+def bed_summary(results_csv: str | Path, ids: set[str] | None = None) -> dict[str, Any]:
     """The bed-temperature rows by temperature and the threshold: the lowest bed temperature
     above which every bed gains at least ``DENSIFIES_SHARE`` of the hottest bed's gain (NaN when
     fewer than two rows finished)."""
-    rows = sorted(_done(read_results(results_csv)), key=lambda r: r["bed_C"])
+    rows = sorted(_done(_rows(results_csv, ids)), key=lambda r: r["bed_C"])
     threshold = math.nan
     if len(rows) >= 2:
         top = rows[-1]["gain"]
@@ -48,12 +55,12 @@ def bed_summary(results_csv: str | Path) -> dict[str, Any]:
     return {"rows": rows, "threshold_C": threshold, "share": DENSIFIES_SHARE}
 
 
-def sensitivity_summary(results_csv: str | Path) -> dict[str, Any]:
+def sensitivity_summary(results_csv: str | Path, ids: set[str] | None = None) -> dict[str, Any]:
     """The reference's final density and, for each factor, the change of the density gained
     over the layer time at its two levels (gain - reference gain) and of the final density (a
     factor that moves the settled powder's density moves the start too), largest change of the
     gain first; failed levels with their error; the ``layer time`` row as the plateau check."""
-    every = read_results(results_csv)
+    every = _rows(results_csv, ids)
     rows = _done(every)
     ref = next((r for r in rows if r["factor"] == "reference"), None)
     if ref is None:
