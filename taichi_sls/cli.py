@@ -6,7 +6,9 @@
                      integrators side by side), hold (a melt that
                      sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
                      neck (the melted-pair study), refinement (the paper's cases under grid and
-                     dt refinement), packing3d (the 3D bed generator's packing fraction)
+                     dt refinement), packing3d (the 3D bed generator's packing fraction),
+                     process (a PA12 layer's density against energy density and bed
+                     temperature, and its sensitivities)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -145,6 +147,7 @@ def parser() -> argparse.ArgumentParser:
         sinter_hold,
         speed,
     )
+    from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
 
     ap = argparse.ArgumentParser(
@@ -158,7 +161,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d",
+        "paper, neck, refinement, packing3d, process",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -173,6 +176,7 @@ def parser() -> argparse.ArgumentParser:
         neck_study,
         refinement,
         bed3d_packing,
+        process_study,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)
