@@ -17,6 +17,7 @@ from taichi_sls.studies.process import plots
 from taichi_sls.studies.process.design import (
     BED_TEMPERATURE_KEYS,
     BED_WIDTH_UM,
+    VISCOSITY_PREFACTOR,
     bed_temperature_sweep,
     energy_sweep,
     sensitivity_sweep,
@@ -108,18 +109,19 @@ def test_the_sensitivity_scales_the_bases_own_values():
     mat = base.materials["PA12"]
     sweep = sensitivity_sweep(BASE)
     by = {(c.params["factor"], c.params["level"]): _overrides(c) for c in sweep.cases}
-    assert float(by[("viscosity x2 / 2", "x2")]["materials.PA12.viscosity_A_Pas"]) == (
-        pytest.approx(2 * mat.viscosity_A_Pas)
-    )
+    # the bundled base's process preset: an Arrhenius law, scaled by its reference viscosity
+    assert mat.viscosity_model == "arrhenius"
+    key = "materials.PA12." + VISCOSITY_PREFACTOR[mat.viscosity_model]
+    assert float(by[("viscosity x2 / 2", "x2")][key]) == pytest.approx(2 * mat.viscosity_ref_Pas)
     gamma = float(by[("surface tension +-20 %", "-20 %")]["materials.PA12.surface_tension_N_m"])
     assert gamma == pytest.approx(0.8 * mat.surface_tension_N_m)
     warm = by[("bed temperature +-3 K", "+3 K")]
     assert {float(warm[k]) for k in BED_TEMPERATURE_KEYS} == {base.thermal.initial_C + 3.0}
     assert float(by[("layer time", f"{base.time.end_s:g} s")]["time.end_s"]) == base.time.end_s
     # another material's base: the same command scales its values
-    other = sensitivity_sweep(BASE, ["materials.PA12.viscosity_A_Pas=1000.0"])
+    other = sensitivity_sweep(BASE, [f"{key}=1000.0"])
     o = {(c.params["factor"], c.params["level"]): _overrides(c) for c in other.cases}
-    assert float(o[("viscosity x2 / 2", "/2")]["materials.PA12.viscosity_A_Pas"]) == 500.0
+    assert float(o[("viscosity x2 / 2", "/2")][key]) == 500.0
 
 
 def test_the_bed_sweep_sets_powder_plate_and_chamber_together():
@@ -227,7 +229,9 @@ def test_the_ids_follow_the_bases_contents(tmp_path):
     ids = [c.id for c in bed_temperature_sweep(copy).cases]
     assert ids == [c.id for c in bed_temperature_sweep(copy).cases]  # stable
     text, n = re.subn(
-        r"(?m)^surface_tension_N_m = .*$", "surface_tension_N_m = 0.030", copy.read_text()
+        r'(?m)^preset = "pa12_process".*$',
+        'preset = "pa12_process"\nsurface_tension_N_m = 0.030',
+        copy.read_text(),
     )
     assert n == 1
     copy.write_text(text)
@@ -238,11 +242,14 @@ def test_the_ids_follow_the_bases_contents(tmp_path):
 def test_the_process_studies_rise_with_energy_and_stop_near_the_crystallisation_range(tmp_path):
     """The energy and bed-temperature studies in full (40 min on two shared cores): at the
     0.1 mm hatch the density gained rises with the Andrew number, and densification stops
-    within 3 K of the base's crystallisation range on cooling (docs/sweeps.md)."""
+    within 3 K of the base's crystallisation range on cooling (docs/sweeps.md), on the base those
+    figures were measured on (a fixed range; the bundled base now crystallises by kinetics)."""
     out = tmp_path / "process"
-    assert cli_main(["bench", "process", "--only", "energy", "bed", "--out", str(out)]) == 0
+    base = ROOT / "tests" / "data" / "machine_layer_range.toml"  # the range the threshold meets
+    args = ["bench", "process", "--base", str(base), "--only", "energy", "bed", "--out", str(out)]
+    assert cli_main(args) == 0
     saved = json.loads((out / "process.json").read_text())
     gains = [r["gain"] for r in saved["energy"] if r["hatch_um"] == 100.0]
     assert gains == sorted(gains) and gains[-1] > gains[0] + 0.02
-    lo, hi = load_case(BASE).materials["PA12"].crystallization_range_C
+    lo, hi = load_case(base).materials["PA12"].crystallization_range_C
     assert lo - 3.0 <= saved["bed_temperature"]["threshold_C"] <= hi + 3.0

@@ -50,7 +50,11 @@ ENERGY_POINTS: tuple[tuple[float, float, float], ...] = (
 BED_TEMPERATURES_C: tuple[float, ...] = (140.0, 145.0, 148.0, 150.0, 155.0, 163.0, 172.0)
 BED_TEMPERATURE_KEYS = ("thermal.initial_C", "thermal.chamber_C", "boundary.bottom.temperature_C")
 # the prefactor that scales a material's melt viscosity under each viscosity_model
-VISCOSITY_PREFACTOR = {"exponential": "viscosity_A_Pas", "constant": "viscosity_Pas"}
+VISCOSITY_PREFACTOR = {
+    "exponential": "viscosity_A_Pas",
+    "constant": "viscosity_Pas",
+    "arrhenius": "viscosity_ref_Pas",  # the law is proportional to its value at the reference
+}
 
 COLLECT = [
     "bed.relative_density.initial",
