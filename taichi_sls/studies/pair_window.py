@@ -13,7 +13,6 @@ the temperature and the viscosity), and prints the neck against Hopper at tau = 
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 from pathlib import Path
@@ -22,9 +21,7 @@ import numpy as np
 
 from ..config import load_case
 from ..config.loading import add_set_argument
-from ..io.atomic import atomic_path
-from ..jobs.case_run import complete_summary, run_case
-from .sinter_hold import compare
+from .sinter_hold import compare, print_against_hopper, run_or_reuse, write_rows
 
 CASE = "pair_window"
 ALIGN_S = 1e-3  # the pulse is over and the pair molten through by then
@@ -84,15 +81,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    run_dir = Path(args.runs) / CASE
-    summary = complete_summary(run_dir)
-    if summary is None:
-        summary = run_case(load_case(CASE, args.set), run_dir)
+    run_dir, summary = run_or_reuse(CASE, args.set, args.runs)
     rows = window_rows(run_dir)
-    with atomic_path(out / "pair_window.csv") as path, path.open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "pair_window.csv", rows)
     R0 = load_case(str(run_dir / "case.toml")).bodies[0].radius_um
     plot(rows, R0, out / "pair_window.png")
     print(
@@ -101,15 +92,5 @@ def main(args: argparse.Namespace) -> int:
         f"{rows[-1]['tau']:.2f}: {max(abs(r['difference']) for r in rows):.2%}",
         file=sys.stderr,
     )
-    tau = np.array([r["tau"] for r in rows])
-    for tq in REPORT_TAU:
-        if tq <= tau[-1]:
-            T, neck, hopper = (
-                float(np.interp(tq, tau, [r[k] for r in rows]))
-                for k in ("T_mean_C", "neck_um", "hopper_neck_um")
-            )
-            print(
-                f"tau = {tq:g}: T_mean {T:.1f} C, neck {neck:.2f} um, Hopper {hopper:.2f} um "
-                f"({neck / hopper - 1:+.2%})"
-            )
-    return 0 if math.isfinite(tau[-1]) else 1
+    print_against_hopper(rows, "tau", REPORT_TAU, "tau = {:g}")
+    return 0 if math.isfinite(rows[-1]["tau"]) else 1

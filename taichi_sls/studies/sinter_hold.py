@@ -136,33 +136,50 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap.set_defaults(func=main)
 
 
-def main(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    run_dir = Path(args.runs) / CASE
+def run_or_reuse(case: str, overrides: list[str], runs: str) -> tuple[Path, dict]:
+    """The run of ``case`` under ``runs``: its folder and summary, run only if not complete."""
+    run_dir = Path(runs) / case
     summary = complete_summary(run_dir)
     if summary is None:
-        summary = run_case(load_case(CASE, args.set), run_dir)
-    rows = compare(run_dir)
-    with atomic_path(out / "sinter_hold.csv") as path, path.open("w", newline="") as f:
+        summary = run_case(load_case(case, overrides), run_dir)
+    return run_dir, summary
+
+
+def write_rows(path: Path, rows: list[dict]) -> None:
+    """``rows`` as a CSV at ``path``, written whole or not at all."""
+    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+
+
+def print_against_hopper(rows: list[dict], key: str, at: tuple[float, ...], label: str) -> None:
+    """The neck against Hopper's at each of ``at`` (of the column ``key``) that the rows reach,
+    each line headed by ``label`` formatted with the value (``"t = {:g} s"``)."""
+    x = np.array([r[key] for r in rows])
+    for xq in at:
+        if xq <= x[-1] * (1 + 1e-9):
+            T, neck, hopper = (
+                float(np.interp(xq, x, [r[k] for r in rows]))
+                for k in ("T_mean_C", "neck_um", "hopper_neck_um")
+            )
+            print(
+                f"{label.format(xq)}: T_mean {T:.1f} C, neck {neck:.2f} um, Hopper {hopper:.2f} um "
+                f"({neck / hopper - 1:+.2%})"
+            )
+
+
+def main(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    run_dir, summary = run_or_reuse(CASE, args.set, args.runs)
+    rows = compare(run_dir)
+    write_rows(out / "sinter_hold.csv", rows)
     plot(rows, out / "sinter_hold.png")
     print(
         f"{CASE}: {summary['steps']} steps ({summary.get('refused_steps', 0)} redone) to "
         f"{summary['simulated_s']:g} s in {summary['step_wall_s']:.1f} s of stepping",
         file=sys.stderr,
     )
-    t = np.array([r["t_s"] for r in rows])
-    for ts in REPORT_S:
-        if ts <= t[-1] * (1 + 1e-9):
-            T, neck, hopper = (
-                float(np.interp(ts, t, [r[k] for r in rows]))
-                for k in ("T_mean_C", "neck_um", "hopper_neck_um")
-            )
-            print(
-                f"t = {ts:g} s: T_mean {T:.1f} C, neck {neck:.2f} um, Hopper {hopper:.2f} um "
-                f"({neck / hopper - 1:+.2%})"
-            )
+    print_against_hopper(rows, "t_s", REPORT_S, "t = {:g} s")
     return 0
