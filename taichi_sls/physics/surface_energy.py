@@ -48,6 +48,8 @@ from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
 from .tetra import tet_corner, tet_triangles
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
+# a node's neighbourhood, offsets -1..1 per axis, by dimension
+NEIGHBOURS = {dim: ((-1, 2),) * dim for dim in (2, 3)}
 
 # Gauss-Legendre points on [0, 1] and weights (summing to 1), by number of points
 GAUSS = {
@@ -159,15 +161,21 @@ def spread_light_nodes(cfg: ti.template(), box: ti.template(), nd: ti.template()
 
 @ti.func
 def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), scale, i, j):
-    I = ti.Vector([i, j])
+    _spread_node_at(cfg, nd, ti.Vector([i, j]))  # in_passes' visitor in 2D
+
+
+@ti.func
+def _spread_node_at(cfg: ti.template(), nd: ti.template(), I):
+    """Node I's share of :func:`spread_light_nodes`: the rest of its surface force to its
+    3^dim - 1 neighbours, by mass."""
     f = nd.surface_force[I]
     m = nd.mass[I]
     if m >= cfg.se.floor_mass:
         scatter_add(cfg, nd.force, I, f)
     elif f.norm_sqr() > 0.0:
         M = 0.0
-        for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2))):  # at run time: one copy
-            if o[0] != 0 or o[1] != 0:
+        for o in ti.grouped(ti.ndrange(*NEIGHBOURS[cfg.dim])):  # at run time: one copy
+            if (o != 0).any():
                 M += nd.mass[I + o]
         keep = m / cfg.se.floor_mass
         if M <= 0.0:
@@ -175,8 +183,8 @@ def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), s
         scatter_add(cfg, nd.force, I, keep * f)
         if M > 0.0:
             rest = (1.0 - keep) / M * f
-            for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2))):
-                if o[0] != 0 or o[1] != 0:
+            for o in ti.grouped(ti.ndrange(*NEIGHBOURS[cfg.dim])):
+                if (o != 0).any():
                     scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
 
 
@@ -332,29 +340,6 @@ def outline_triangles(
 
 
 @ti.func
-def _spread_node_3d(cfg: ti.template(), nd: ti.template(), I):
-    """:func:`_spread_node` in 3D: the rest to the 26 neighbours, by mass."""
-    f = nd.surface_force[I]
-    m = nd.mass[I]
-    if m >= cfg.se.floor_mass:
-        scatter_add(cfg, nd.force, I, f)
-    elif f.norm_sqr() > 0.0:
-        M = 0.0
-        for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2), (-1, 2))):
-            if (o != 0).any():
-                M += nd.mass[I + o]
-        keep = m / cfg.se.floor_mass
-        if M <= 0.0:
-            keep = 1.0
-        scatter_add(cfg, nd.force, I, keep * f)
-        if M > 0.0:
-            rest = (1.0 - keep) / M * f
-            for o in ti.grouped(ti.ndrange((-1, 2), (-1, 2), (-1, 2))):
-                if (o != 0).any():
-                    scatter_add(cfg, nd.force, I + o, nd.mass[I + o] * rest)
-
-
-@ti.func
 def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), t):
     """The outline of the colour field and its surface-energy force, added to nd.force."""
     if ti.static(cfg.se.spread):
@@ -368,6 +353,6 @@ def surface_energy_force(cfg: ti.template(), box: ti.template(), nd: ti.template
     if ti.static(cfg.se.spread):
         if ti.static(cfg.dim == 3):
             for I in ti.grouped(ti.ndrange(*active(box))):
-                _spread_node_3d(cfg, nd, I)
+                _spread_node_at(cfg, nd, I)
         else:
             spread_light_nodes(cfg, box, nd)
