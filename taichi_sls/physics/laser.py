@@ -89,6 +89,22 @@ def hatch_source(las: ti.template(), xp, t, dt):
 
 
 @ti.func
+def lit_interval(t, dt, on, off, start, end, speed):
+    """The part [t0, t1] of the step [t, t + dt] in which a beam switched on at ``on`` and off
+    at ``off`` is lit (empty where t1 <= t0): it is off while its centre start + speed (t - on)
+    lies beyond end."""
+    t0 = ti.max(t, on)
+    t1 = ti.min(t + dt, off)
+    if speed > 0.0:
+        t1 = ti.min(t1, on + (end - start) / speed)
+    elif speed < 0.0:
+        t0 = ti.max(t0, on + (end - start) / speed)
+    elif start > end:
+        t1 = t0
+    return t0, t1
+
+
+@ti.func
 def spot_source_3d(las: ti.template(), xp, t, dt):
     """Mean power per unit volume at xp over [t, t + dt] of a 3D beam's tracks in the bed
     (module docstring), without the depth factor; each track's on-time within the step exact,
@@ -104,17 +120,9 @@ def spot_source_3d(las: ti.template(), xp, t, dt):
     n = ti.cast(las.tracks, ti.i32)
     for k in range(n):
         on = las.on_s + k * las.return_s
-        t0 = ti.max(t, on)
-        t1 = ti.min(t + dt, las.off_s)
-        if k < n - 1:
+        t0, t1 = lit_interval(t, dt, on, las.off_s, start, end, speed)
+        if k < n - 1:  # until the next track starts
             t1 = ti.min(t1, on + las.return_s)
-        # the track is off while its centre start + speed (t - on) lies beyond end
-        if speed > 0.0:
-            t1 = ti.min(t1, on + (end - start) / speed)
-        elif speed < 0.0:
-            t0 = ti.max(t0, on + (end - start) / speed)
-        elif start > end:
-            t1 = t0
         if t1 > t0:
             da = start + speed * (0.5 * (t0 + t1) - on) - along
             dl = lateral0 + k * las.hatch_m - across
@@ -155,15 +163,7 @@ def laser_source(cfg: ti.template(), lasers: ti.template(), xp, t, dt, column_to
         x0 = las.x_start_m
         speed = las.speed_m_s
         x_end = las.x_end_m
-        t0 = ti.max(t, on)
-        t1 = ti.min(t + dt, las.off_s)
-        # the beam is off while its centre x0 + speed (t - on) lies beyond x_end
-        if speed > 0.0:
-            t1 = ti.min(t1, on + (x_end - x0) / speed)
-        elif speed < 0.0:
-            t0 = ti.max(t0, on + (x_end - x0) / speed)
-        elif x0 > x_end:
-            t1 = t0
+        t0, t1 = lit_interval(t, dt, on, las.off_s, x0, x_end, speed)
         if t1 > t0:
             xl = x0 + speed * (0.5 * (t0 + t1) - on)
             r0 = las.spot_radius_m
