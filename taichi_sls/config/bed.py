@@ -157,43 +157,50 @@ def read_columns(path: str, key: str, columns: tuple[str, ...]) -> tuple[np.ndar
     return np.array(rows), lines
 
 
-def _check_csv(bed: Bed, x, y, r, lines, old: np.ndarray, width_um, height_um) -> None:
-    """Inside the domain, no overlaps (with each other and the earlier disc bodies ``old``:
-    x, y, r rows), and every disc supported."""
-    tol = bed.overlap_tolerance_um
-    W = math.inf if width_um is None else width_um
-    H = math.inf if height_um is None else height_um
-    out = (x - r < -tol) | (y - r < -tol) | (x + r > W + tol) | (y + r > H + tol)
+def check_csv_rows(bed: Bed, rows: np.ndarray, lines: list[int], old: np.ndarray, box) -> None:
+    """A bed CSV's particles (rows: centre coordinates then radius, um; discs in 2D, spheres in
+    3D) inside the domain ``box`` (its extents; None: sized to the bed), overlapping neither
+    each other nor the earlier body particles ``old`` (rows of the same columns), and each
+    supported by the plate or a lower particle."""
+    tol, key = bed.overlap_tolerance_um, f"bed.csv = {bed.csv!r}"
+    dim = len(box)
+    noun = "disc" if dim == 2 else "sphere"
+    c, r = rows[:, :dim], rows[:, dim]
+    hi = np.array([math.inf if s is None else s for s in box])
+    out = np.any((c - r[:, None] < -tol) | (c + r[:, None] > hi + tol), axis=1)
     if out.any():
         k = int(np.argmax(out))
+        at = ", ".join(f"{v:g}" for v in c[k])
+        extent = " x ".join(f"0..{v:g}" for v in hi)
+        names = "domain.width_um, domain.height_um" + (", domain.depth_um" if dim == 3 else "")
         raise CaseError(
-            f"bed.csv = {bed.csv!r} line {lines[k]}: the disc at ({x[k]:g}, {y[k]:g}) um of "
-            f"radius {r[k]:g} um lies outside the domain 0..{W:g} x 0..{H:g} um (domain.width_um, "
-            "domain.height_um; y = 0 is the plate)"
+            f"{key} line {lines[k]}: the {noun} at ({at}) um of radius {r[k]:g} um lies outside "
+            f"the domain {extent} um ({names}; y = 0 is the plate)"
         )
-    ax, ay, ar = (np.concatenate([a, old[:, k]]) for k, a in enumerate((x, y, r)))
-    n = len(x)
-    gap = np.hypot(x[:, None] - ax, y[:, None] - ay) - (r[:, None] + ar)
+    ac, ar = np.concatenate([c, old[:, :dim]]), np.concatenate([r, old[:, dim]])
+    n = len(r)
+    gap = np.linalg.norm(c[:, None] - ac[None], axis=2) - (r[:, None] + ar)
     gap[np.arange(n), np.arange(n)] = np.inf
-    earlier = np.arange(gap.shape[1])[None, :] < np.arange(n)[:, None]
-    earlier[:, n:] = True  # the body discs come before every row
+    earlier = np.arange(len(ar))[None, :] < np.arange(n)[:, None]
+    earlier[:, n:] = True  # the body particles come before every row
     bad = np.nonzero(((gap < -tol) & earlier).any(axis=1))[0]
-    if len(bad):  # the first row that overlaps a disc before it
+    if len(bad):  # the first row that overlaps a particle before it
         i = int(bad[0])
         j = int(np.argmin(np.where(earlier[i], gap[i], np.inf)))
-        other = f"line {lines[j]}" if j < n else f"disc body {j - n} of [[bodies]]"
+        other = f"line {lines[j]}" if j < n else f"{noun} body {j - n} of [[bodies]]"
         raise CaseError(
-            f"bed.csv = {bed.csv!r} line {lines[i]}: the disc overlaps {other} by "
-            f"{-gap[i, j]:.4g} um; at most bed.overlap_tolerance_um = {tol} is allowed"
+            f"{key} line {lines[i]}: the {noun} overlaps {other} by {-gap[i, j]:.4g} um; at "
+            f"most bed.overlap_tolerance_um = {tol} is allowed"
         )
-    below = ay[None, :] < y[:, None]
-    supported = (y - r <= tol) | ((gap <= tol) & below).any(axis=1)
+    below = ac[None, :, 1] < c[:, None, 1]
+    supported = (c[:, 1] - r <= tol) | ((gap <= tol) & below).any(axis=1)
     if not supported.all():
         k = int(np.argmin(supported))
+        at = ", ".join(f"{v:g}" for v in c[k])
         raise CaseError(
-            f"bed.csv = {bed.csv!r} line {lines[k]}: the disc at ({x[k]:g}, {y[k]:g}) um "
-            f"floats: it touches neither the plate nor a lower disc (within "
-            f"bed.overlap_tolerance_um = {tol}); floating particles are not allowed"
+            f"{key} line {lines[k]}: the {noun} at ({at}) um floats: it touches neither the "
+            f"plate nor a lower {noun} (within bed.overlap_tolerance_um = {tol}); floating "
+            "particles are not allowed"
         )
 
 
@@ -242,7 +249,7 @@ def bed_discs(
     if bed.csv is not None:
         data, lines = read_columns(bed.csv, "bed.csv", ("x_um", "y_um", "radius_um"))
         x, y, r = data.T
-        _check_csv(bed, x, y, r, lines, old, width_um, height_um)
+        check_csv_rows(bed, data, lines, old, (width_um, height_um))
         source.append(f"csv {Path(bed.csv).name}")
     generate = bed.count is not None or bed.layers is not None
     if bed.x_range_um is not None:

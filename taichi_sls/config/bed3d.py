@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .bed import Bed, bed_diameters, read_columns
+from .bed import Bed, bed_diameters, check_csv_rows, read_columns
 from .bodies import Disc
 from .deposition3d import deposit_spheres
 from .errors import CaseError
@@ -115,7 +115,7 @@ def bed_spheres(
     csv, source = np.empty((0, 4)), []
     if bed.csv is not None:
         csv, lines = read_columns(bed.csv, "bed.csv", COLUMNS)
-        _check_csv(bed, csv, lines, old, (width, height, depth))
+        check_csv_rows(bed, csv, lines, old, (width, height, depth))
         source.append(f"csv {Path(bed.csv).name}")
     (x0, x1), (z0, z1) = _ranges(bed, width, depth, csv)
     n = bed.count
@@ -171,43 +171,3 @@ def _contacts(c: np.ndarray, r: np.ndarray) -> int:
     a, b = pairs.T
     gap = np.linalg.norm(c[a] - c[b], axis=1) - r[a] - r[b]
     return int(np.sum(gap <= 1e-9 * np.maximum(r[a], r[b])))
-
-
-def _check_csv(bed: Bed, rows: np.ndarray, lines: list[int], old: np.ndarray, box) -> None:
-    """Inside the domain, no overlaps (with each other and the sphere bodies ``old``), and
-    every sphere supported by the plate or a lower sphere."""
-    tol, key = bed.overlap_tolerance_um, f"bed.csv = {bed.csv!r}"
-    c, r = rows[:, :3], rows[:, 3]
-    hi = np.array([math.inf if s is None else s for s in box])
-    out = np.any((c - r[:, None] < -tol) | (c + r[:, None] > hi + tol), axis=1)
-    if out.any():
-        k = int(np.argmax(out))
-        raise CaseError(
-            f"{key} line {lines[k]}: the sphere at {[float(v) for v in c[k]]} um of radius "
-            f"{r[k]:g} um lies outside the domain 0..{hi[0]:g} x 0..{hi[1]:g} x 0..{hi[2]:g} um "
-            "(domain.width_um, height_um, depth_um; y = 0 is the plate)"
-        )
-    ac, ar = np.concatenate([c, old[:, :3]]), np.concatenate([r, old[:, 3]])
-    n = len(r)
-    gap = np.linalg.norm(c[:, None] - ac[None], axis=2) - (r[:, None] + ar)
-    gap[np.arange(n), np.arange(n)] = np.inf
-    earlier = np.arange(len(ar))[None, :] < np.arange(n)[:, None]
-    earlier[:, n:] = True  # the sphere bodies come before every row
-    bad = np.nonzero(((gap < -tol) & earlier).any(axis=1))[0]
-    if len(bad):
-        i = int(bad[0])
-        j = int(np.argmin(np.where(earlier[i], gap[i], np.inf)))
-        other = f"line {lines[j]}" if j < n else f"sphere body {j - n} of [[bodies]]"
-        raise CaseError(
-            f"{key} line {lines[i]}: the sphere overlaps {other} by {-gap[i, j]:.4g} um; at "
-            f"most bed.overlap_tolerance_um = {tol} is allowed"
-        )
-    below = ac[None, :, 1] < c[:, None, 1]
-    supported = (c[:, 1] - r <= tol) | ((gap <= tol) & below).any(axis=1)
-    if not supported.all():
-        k = int(np.argmin(supported))
-        raise CaseError(
-            f"{key} line {lines[k]}: the sphere at {[float(v) for v in c[k]]} um floats: it "
-            f"touches neither the plate nor a lower sphere (within bed.overlap_tolerance_um = "
-            f"{tol}); floating particles are not allowed"
-        )

@@ -189,10 +189,10 @@ def test_a_csv_of_spheres_and_spheres_deposited_on_it(tmp_path):
     "rows, says",
     [
         ("20,10,20,10\n25,10,20,10\n", "line 3: the sphere overlaps line 2 by 15 um"),
-        ("20,10,20,10\n20,40,20,10\n", "line 3: the sphere at [20.0, 40.0, 20.0] um floats"),
+        ("20,10,20,10\n20,40,20,10\n", "line 3: the sphere at (20, 40, 20) um floats"),
         (
             "20,10,55,10\n",
-            "line 2: the sphere at [20.0, 10.0, 55.0] um of radius 10 um lies "
+            "line 2: the sphere at (20, 10, 55) um of radius 10 um lies "
             "outside the domain 0..60 x 0..60 x 0..60 um",
         ),
         ("20,10,20\n", "line 2: 3 fields, the header has 4"),
