@@ -107,6 +107,9 @@ def run_command(args: argparse.Namespace) -> int:
     except CaseError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    if "final" not in summary:  # failed before the first frame (settling, say)
+        print(f"error: {summary.get('error', summary['status'])}", file=sys.stderr)
+        return EXIT_CODES[summary["status"]]
     fin = summary["final"]
     print(
         f"{summary['status']}: {summary['steps']} steps, {summary['simulated_s'] * 1e3:.3g} ms "

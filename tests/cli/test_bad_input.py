@@ -35,3 +35,29 @@ def test_python_m_bad_file_one_line(tmp_path, module, content, says):
     assert r.returncode == 2, r.stderr
     assert len(lines) == 1 and lines[0].startswith(f"error: {p}: ") and says in lines[0]
     assert "Traceback" not in r.stderr and r.stdout == ""
+
+
+def test_a_pair_that_never_settles_ends_with_its_error(tmp_path, capsys):
+    """contact.settle failing before the first frame (time.max_s too short) ends the run as
+    failed with the settle's one error line and the failed exit status, not a KeyError."""
+    from taichi_sls.cli import EXIT_CODES, main
+
+    code = main(
+        [
+            "run",
+            str(ROOT / "cases" / "power25W_resolved.toml"),
+            "--out",
+            str(tmp_path / "o"),
+            "--no-progress",
+            "--set",
+            "grid.spacing_um=4",
+            "--set",
+            "time.max_s=3e-5",
+            "--set",
+            "output.gif=false",
+        ]
+    )
+    err = capsys.readouterr().err
+    assert code == EXIT_CODES["failed"] != 0
+    assert "error: contact.settle: the bodies had not settled by time.max_s = 3e-05 s" in err
+    assert "Traceback" not in err and "KeyError" not in err
