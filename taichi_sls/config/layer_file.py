@@ -6,11 +6,12 @@ seeded volume times J, per unit depth); ``body`` (N,) the body each point belong
 run; ``material`` (N,) an index into ``material_names``; ``T_C`` (N,) temperatures; ``info`` a
 one-line JSON text (case name, time reached, status). Optional, the points' mechanical state
 as the run left it (``volume0_um2``, the seeded volumes, and ``state_<member>`` for each of
-CARRIED_STATE): a soft solid under surface tension sits in equilibrium with its stress (a pore
-or a neck compressed by 10-20 % at the paper's 1e5 Pa modulus), so a layer restarted
-stress-free would be squeezed again by the unbalanced surface force and ring (measured: 1-2 m/s
-within a microsecond; tests/jobs/test_bed_refrozen.py). Written by the run (jobs/case_run.py,
-io/layer_output.py); read here, checked, once per file.
+CARRIED_STATE, and of OPTIONAL_STATE where the run wrote it): a soft solid under surface
+tension sits in equilibrium with its stress (a pore or a neck compressed by 10-20 % at the
+paper's 1e5 Pa modulus), so a layer restarted stress-free would be squeezed again by the
+unbalanced surface force and ring (measured: 1-2 m/s within a microsecond;
+tests/jobs/test_bed_refrozen.py). Written by the run (jobs/case_run.py, io/layer_output.py);
+read here, checked, once per file.
 """
 
 from __future__ import annotations
@@ -38,6 +39,10 @@ CARRIED_STATE = (
     "elastic_stretch",
     "stress_phase",
 )
+# carried when present: the melt's solid fraction, so that a layer that ended molten (an
+# amorphous melt on a bed inside the sintering window) restarts molten at the bed temperature;
+# a file without it restarts each point at the phase of that temperature
+OPTIONAL_STATE = ("solid_fraction",)
 
 
 @dataclass(frozen=True)
@@ -93,6 +98,7 @@ def layer_arrays(
         # single precision: strains and stresses to 1e-7 relative, half the file (a bed's state
         # is some 40 numbers a point)
         carried = {f"state_{k}": np.asarray(state[k], dtype=np.float32) for k in CARRIED_STATE}
+        carried |= {f"state_{k}": np.asarray(state[k]) for k in OPTIONAL_STATE if k in state}
         carried["volume0_um2"] = np.asarray(volume0_um2, dtype=np.float64)
     return {
         **carried,
@@ -131,7 +137,8 @@ def _read_layer(path: str, key: str, _mtime_ns: int, _size: int) -> Layer:
             carried = all(f"state_{k}" in f.files for k in CARRIED_STATE)
             if carried and "volume0_um2" in f.files:
                 a["volume0_um2"] = f["volume0_um2"]
-                a["state"] = {k: f[f"state_{k}"].astype(np.float64) for k in CARRIED_STATE}
+                kept = [*CARRIED_STATE, *(k for k in OPTIONAL_STATE if f"state_{k}" in f.files)]
+                a["state"] = {k: f[f"state_{k}"].astype(np.float64) for k in kept}
     except (OSError, ValueError) as e:
         if isinstance(e, CaseError):
             raise

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..config import Case, case_to_toml
-from ..config.layer_file import CARRIED_STATE
+from ..config.layer_file import CARRIED_STATE, OPTIONAL_STATE
 from ..io.bed_outcome_plot import plot_bed_outcome
 from ..io.contacts_plot import plot_contacts
 from ..io.contacts_table import read_contacts, write_contacts
@@ -346,7 +346,8 @@ def _compiled(clock0: dict[str, float]) -> dict[str, float]:
 
 def write_layer_file(path: Path, sim: Simulation, status: str) -> None:
     """The points as they are now, for a case that deposits a layer on them (bed.previous_layer)."""
-    pt, sc = sim.point_arrays(("x", "volume0", "J", "T", *CARRIED_STATE)), sim.scene
+    carried = (*CARRIED_STATE, *OPTIONAL_STATE)
+    pt, sc = sim.point_arrays(("x", "volume0", "J", "T", *carried)), sim.scene
     write_layer(
         path,
         x_um=pt["x"] * 1e6,
@@ -357,7 +358,7 @@ def write_layer_file(path: Path, sim: Simulation, status: str) -> None:
         T_C=pt["T"] - KELVIN,
         info={"case": sim.case.case.name, "t_s": sim.t, "status": status},
         volume0_um2=pt["volume0"] * 1e12,
-        state={k: pt[k] for k in CARRIED_STATE},
+        state={k: pt[k] for k in carried},
     )
 
 

@@ -34,7 +34,13 @@ from ..physics.beam_surface import column_shape
 from ..physics.constitutive import embed3, moduli, perzyna_update
 from ..physics.curvature import fit_matrix
 from ..physics.laser import laser_struct
-from ..physics.materials import KELVIN, enthalpy, material_struct, solid_fraction
+from ..physics.materials import (
+    KELVIN,
+    enthalpy,
+    enthalpy_history,
+    material_struct,
+    solid_fraction,
+)
 from ..physics.small_matrix import IDENTITY, ZERO_MATRIX
 from ..physics.stiffness import WIDTH
 from . import struct_copy
@@ -249,6 +255,8 @@ class State:
             for name, values in sc.carried_state.items():
                 now[name][sc.carried] = values[sc.carried]
             struct_copy.from_numpy(pt, now)
+            if "solid_fraction" in sc.carried_state:  # a melt restarts molten: H(T, xi)
+                self._enthalpy_at_fraction()
 
     @ti.kernel
     def _init_points(self, p0: ti.types.ndarray()):
@@ -273,6 +281,15 @@ class State:
             pt.stress_phase[p] = pt.solid_fraction[p]
             if p0[p] != 0.0:
                 self._prestress(p, p0[p])
+
+    @ti.kernel
+    def _enthalpy_at_fraction(self):
+        """Each point's enthalpy at its temperature and its (carried) solid fraction; the
+        points seeded here hold their temperature's fraction, so theirs is unchanged."""
+        pt = ti.static(self.points)
+        for p in range(self.cfg.n_points):
+            mp = self.materials[pt.material[p]]
+            pt.enthalpy[p] = enthalpy_history(mp, pt.T[p], pt.solid_fraction[p])
 
     @ti.func
     def _prestress(self, p, p0):
