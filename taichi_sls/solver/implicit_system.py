@@ -71,7 +71,8 @@ def gather(
                     value = 0.0
                     if c >= 0:
                         if part == Part.FIXED:
-                            value = st.implicit.fixed[I, o, a, b]
+                            if a == b:  # a scalar times the identity (ImplicitFields)
+                                value = st.implicit.fixed[I, o]
                         else:
                             value = st.implicit.tangent[I, o, a, b]
                     vals[k, slot] = value
