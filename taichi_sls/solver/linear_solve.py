@@ -34,11 +34,21 @@ class LinearSolveError(RuntimeError):
     with a fresh preconditioner did not converge."""
 
 
+# time.direct_max_unknowns unset: the largest direct solve by dimension (docs/implicit.md)
+DIRECT_MAX_UNKNOWNS = {2: 200_000, 3: 40_000}
+
+
+def direct_max_unknowns(case: Case) -> int:
+    """``time.direct_max_unknowns``, or where unset the dimension's DIRECT_MAX_UNKNOWNS."""
+    limit = case.time.direct_max_unknowns
+    return DIRECT_MAX_UNKNOWNS[case.domain.dim] if limit is None else limit
+
+
 def linear_solver(case: Case, n: int) -> str:
     """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
     choice = case.time.linear_solver
     if choice == "auto":
-        choice = "direct" if n <= case.time.direct_max_unknowns else "amg"
+        choice = "direct" if n <= direct_max_unknowns(case) else "amg"
     return choice
 
 
