@@ -314,6 +314,8 @@ class ImplicitStepper:
         how = linear_solver(self.case, sys_.n)
         if self.linear is None or self.linear.how != how:
             self.linear = LinearSolver(how, LINEAR_RTOL)
+        if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
+            self.linear.near_null = sys_.rigid_body_modes()
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
         if self.penalty > 0.0:  # the light nodes' near-null modes (module docstring)

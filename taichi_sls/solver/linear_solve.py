@@ -15,7 +15,9 @@ are few, and scipy's wrapper cost as much per call as two of them.
   the symbolic one while the pattern is unchanged), or where a matrix is not positive definite
   qdldl's LDL^T with AMD ordering: exact for the matrix it was built from.
 - ``amg``: pyamg's smoothed-aggregation hierarchy as the preconditioner (memory and time linear
-  in the unknowns, for the large systems where a factorization's fill grows too big).
+  in the unknowns, for the large systems where a factorization's fill grows too big); given
+  ``near_null`` (the implicit step gives the rigid-body modes of its grid velocities, 3 in 2D
+  and 6 in 3D), its aggregates interpolate those exactly, as elasticity wants.
 """
 
 from collections.abc import Callable
@@ -76,6 +78,9 @@ class LinearSolver:
         self._factor = None
         self._factored: sp.csr_matrix | None = None  # the matrix the factorization is of
         self._precondition: Callable[[np.ndarray], np.ndarray] | None = None
+        # amg: the matrix's near-null modes (columns), which smoothed aggregation keeps exact
+        # on its coarse levels; None: the constant vector (pyamg's default)
+        self.near_null: np.ndarray | None = None
 
     def solve(self, A: sp.csr_matrix, b: np.ndarray, refresh: bool = False) -> np.ndarray:
         """x with |A x - b| <= rtol |b|; ``refresh``: factorize A afresh (direct: solve with it;
@@ -122,7 +127,9 @@ class LinearSolver:
         else:
             import pyamg
 
-            ml = pyamg.smoothed_aggregation_solver(A, symmetry="symmetric", max_coarse=500)
+            ml = pyamg.smoothed_aggregation_solver(
+                A, B=self.near_null, symmetry="symmetric", max_coarse=500
+            )
             self._factor = ml
             self._precondition = ml.aspreconditioner(cycle="V").matvec
         self._pattern = (A.indptr.copy(), A.indices.copy())
