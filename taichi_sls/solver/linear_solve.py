@@ -89,21 +89,24 @@ class LinearSolver:
         if A is self._factored and self.how == "direct":
             return self._factor.solve(b)
         same = self._same_pattern(A)
-        if refresh or not same:
+        fresh = refresh or not same
+        if fresh:
             self._factorize(A, new_pattern=not same)
             if self.how == "direct":
                 return self._factor.solve(b)
-        x, converged = self._cg(A, b, self.refresh_after)
-        if not converged:
+        # a fresh hierarchy is not set up again: CG runs on to its limit with it (the same
+        # iterates as a second set-up from the same matrix, at half the cost)
+        x, converged = self._cg(A, b, CG_MAX_ITERATIONS if fresh else self.refresh_after)
+        if not converged and not fresh:
             self._factorize(A, new_pattern=False)
             if self.how == "direct":
                 return self._factor.solve(b)
             x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
-            if not converged:
-                raise LinearSolveError(
-                    f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
-                    f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
-                )
+        if not converged:
+            raise LinearSolveError(
+                f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
+                f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
+            )
         return x
 
     def _same_pattern(self, A: sp.csr_matrix) -> bool:
