@@ -158,8 +158,9 @@ class Time(Model):
         None,
         ge=1,
         description='implicit, linear_solver = "auto": the largest direct solve, in unknowns; '
-        "unset: 200000 in 2D, 40000 in 3D (a 3D row holds 375 entries, not 75: the Cholesky "
-        "factor fills faster, and beyond some 40k unknowns AMG-CG solves faster; docs/implicit.md)",
+        "unset: 200000 in 2D, 40000 in 3D (a 3D row holds up to 375 entries, not 75: the "
+        "Cholesky factor fills faster, and AMG-CG solves as fast near 35k unknowns; "
+        "docs/implicit.md)",
     )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
         "auto",

@@ -5,7 +5,8 @@ Two molten PA12 spheres, R = 20 um, touching at a point in a 120 x 60 x 60 um bo
 tension on, no gravity), implicit steps at the "auto" step, at h = 4, 3 and 2.5 um (``--quick``:
 4 only), each with the direct solver (CHOLMOD) and with AMG-CG (pyamg's smoothed aggregation
 with the rigid-body modes). After one step (which compiles), ``--steps`` steps are timed: the
-wall time per step and per Newton linear solve, Newton iterations, the unknowns, and the
+wall time per step and per Newton linear solve, Newton iterations, CG iterations per solve
+(0: the factorization alone), the unknowns, and the
 implicit grid rows' memory per grid node, per active node (one with unknowns) and per point.
 Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/implicit.md, "In
 3D")."""
@@ -33,6 +34,7 @@ COLUMNS = [
     "wall_per_step_s",
     "wall_per_solve_s",
     "newton_iterations_per_step",
+    "cg_iterations_per_solve",
     "bytes_per_node",
     "bytes_per_active_node",
     "bytes_per_point",
@@ -83,6 +85,7 @@ def measure(h_um: float, solver: str, steps: int) -> dict:
     linear_solve.LinearSolver.solve = timed
     try:
         newton0 = sim.implicit.newton_total
+        cg0 = sim.implicit.linear.stats.cg_iterations
         t0 = time.perf_counter()
         sim.advance(steps)
         wall = time.perf_counter() - t0
@@ -103,6 +106,9 @@ def measure(h_um: float, solver: str, steps: int) -> dict:
         "wall_per_step_s": round(wall / steps, 3),
         "wall_per_solve_s": round(spent["s"] / max(spent["n"], 1), 4),
         "newton_iterations_per_step": round((sim.implicit.newton_total - newton0) / steps, 2),
+        "cg_iterations_per_solve": round(
+            (sim.implicit.linear.stats.cg_iterations - cg0) / max(spent["n"], 1), 1
+        ),
         "bytes_per_node": round(grid / nodes),
         "bytes_per_active_node": round(grid / max(active, 1)),
         "bytes_per_point": round(grid / sim.scene.n_points),
@@ -128,7 +134,8 @@ def main(args: argparse.Namespace) -> int:
             print(
                 f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['unknowns']:7d} unknowns "
                 f"{r['wall_per_step_s']:7.2f} s/step {r['wall_per_solve_s']:7.3f} s/solve "
-                f"{r['newton_iterations_per_step']:5.2f} Newton/step  "
+                f"{r['newton_iterations_per_step']:5.2f} Newton/step "
+                f"{r['cg_iterations_per_solve']:5.1f} CG/solve  "
                 f"{r['bytes_per_node']} B/node {r['bytes_per_active_node']} B/active node "
                 f"{r['bytes_per_point']} B/point",
                 flush=True,
