@@ -141,6 +141,7 @@ def parser() -> argparse.ArgumentParser:
         bed3d_packing,
         compile_bench,
         cost_error,
+        implicit3d_bench,
         implicit_bench,
         neck_study,
         pair_window,
@@ -163,8 +164,8 @@ def parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub)
     bench = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d, process",
+        help="benchmarks and studies: speed, compile, cost, implicit, implicit3d, hold, window, "
+        "accuracy, paper, neck, refinement, packing3d, process",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -172,6 +173,7 @@ def parser() -> argparse.ArgumentParser:
         compile_bench,
         cost_error,
         implicit_bench,
+        implicit3d_bench,
         sinter_hold,
         pair_window,
         accuracy,

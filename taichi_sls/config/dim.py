@@ -134,11 +134,6 @@ def _refuse_in_3d(case: Any) -> None:
             f"contact.settle = true with domain.dim = 3: settling reads the neck, {not_yet}; "
             "allowed in 3D: false"
         )
-    if case.time.integrator != "explicit":
-        raise CaseError(
-            f"time.integrator = {case.time.integrator!r} with domain.dim = 3: the implicit "
-            f'system is {not_yet}; allowed in 3D: "explicit"'
-        )
     if case.time.stop == "solidified":
         raise CaseError(
             f'time.stop = "solidified" with domain.dim = 3: the fusion verdict reads neck '

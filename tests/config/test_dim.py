@@ -91,8 +91,6 @@ REFUSED_IN_3D = [
     ),
     ({"contact": {"initial": "fillet"}}, 'contact.initial = "fillet"'),
     ({"contact": {"settle": True}}, "contact.settle = true"),
-    ({"time": {"integrator": "implicit"}}, "time.integrator = 'implicit'"),
-    ({"time": {"integrator": "hybrid"}}, "time.integrator = 'hybrid'"),
     ({"time": {"stop": "solidified"}}, 'time.stop = "solidified"'),
     ({"thermal": {"top_surface": "chamber"}}, "thermal.top_surface = 'chamber'"),
     ({"solver": {"layout": "blocks"}}, 'solver.layout = "blocks"'),
