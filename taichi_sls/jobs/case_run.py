@@ -31,6 +31,7 @@ from ..io.contacts_table import read_contacts, write_contacts
 from ..io.layer_output import write_layer
 from ..io.outcome_plot import plot_outcome
 from ..io.vtu import point_data
+from ..io.frames3d import view_3d
 from ..io.writer import OutputWriter
 from ..physics.materials import KELVIN
 from ..solver import compile_clock
@@ -67,6 +68,7 @@ def _writer(case: Case, out_dir: Path) -> OutputWriter:
         dpi=o.dpi,
         deformation=o.deformation,
         bed=is_bed(case),
+        view3d=view_3d(case) if case.domain.dim == 3 else None,
     )
 
 

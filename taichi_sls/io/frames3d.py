@@ -1,0 +1,181 @@
+"""Frame images of a 3D run, drawn on the CPU with matplotlib alone (no GPU, no PyVista):
+
+1. the temperature on a section through the material (the x-y plane at ``section_z_um``: the
+   laser's track if it scans along x, else the mid-depth; y up as in the 2D frames), the melt
+   outlined (liquid fraction 1/2, cyan);
+2. the liquid fraction on the same section;
+3. the material's surface (colour c = 1/2, io/surface3d.py) in perspective, coloured by the
+   temperature and lit by one distant light (Lambert: the colour times 0.3 + 0.7 cos of the
+   angle between the surface's normal and the light).
+
+The section and the surface are read off one colour grid of the point spacing
+(io/surface3d.colour_grid), so the section's material and the surface agree. One figure is
+reused across frames (headless Agg); only the artists change."""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+from .frames import MELT_LEVEL, _finite_range, save_png, temperature_cmap
+from .surface3d import SURFACE_LEVEL, ColourGrid, Surface
+
+# the light: from above (y), in front (-z: the viewer's side) and to the left (-x)
+LIGHT = np.array([-0.4, 1.0, -0.6]) / np.linalg.norm([-0.4, 1.0, -0.6])
+AMBIENT = 0.3  # the light a face turned away from the light still gets
+VIEW_ELEV_DEG, VIEW_AZIM_DEG = 25.0, -60.0  # the camera of the surface panel
+PANEL_W_IN = 3.6  # inches per panel: three panels and colour bars ~ 950 px at dpi 80
+
+
+@dataclass(frozen=True)
+class View3D:
+    """What a 3D frame needs beyond the 2D one: the box's z range (um), the seeding's point
+    spacing (um; the colour grid's spacing) and the section's z (um)."""
+
+    z_range_um: tuple[float, float]
+    point_spacing_um: float
+    section_z_um: float
+
+
+def view_3d(case: Any) -> View3D:
+    """The 3D frame of ``case``: the box with its ghost layer in z as in x, the seeding's point
+    spacing, the section at the first laser's track if it scans along x, else at mid-depth."""
+    g = case.grid
+    ghost = g.ghost_cells * g.spacing_um
+    depth = case.domain.depth()
+    along_x = [las for las in case.lasers if las.direction == "x"]
+    z = along_x[0].z_start_um if along_x else 0.5 * depth
+    return View3D((-ghost, depth + ghost), g.spacing_um / g.points_per_cell, float(z))
+
+
+def shade(normals: np.ndarray) -> np.ndarray:
+    """Lambert's factor of unit normals (T, 3) in the solver's axes: AMBIENT .. 1."""
+    return AMBIENT + (1.0 - AMBIENT) * np.clip(normals @ LIGHT, 0.0, None)
+
+
+class Frame3DPainter:
+    """Draws one 3D frame (section of T, section of the liquid fraction, lit surface)."""
+
+    def __init__(
+        self,
+        domain_um: tuple[float, float, float, float],
+        view: View3D,
+        melt_C: float,
+        bed: bool = False,
+    ) -> None:
+        self.domain_um = domain_um
+        self.view = view
+        self.melt_C = melt_C
+        self.cmap = temperature_cmap(bed)
+        self._fig: Figure | None = None
+
+    def _setup(self) -> None:
+        xmin, xmax, ymin, ymax = self.domain_um
+        zmin, zmax = self.view.z_range_um
+        h_in = min(max(PANEL_W_IN * (ymax - ymin) / (xmax - xmin), 1.5), 5.0) + 1.2
+        fig = Figure(figsize=(3.4 * PANEL_W_IN + 1.6, h_in))
+        FigureCanvasAgg(fig)
+        fig.subplots_adjust(left=0.05, right=0.98, bottom=0.12, top=0.84, wspace=0.4)
+        gs = fig.add_gridspec(1, 3, width_ratios=(1.0, 1.0, 1.4))
+        ax_t = fig.add_subplot(gs[0])
+        ax_l = fig.add_subplot(gs[1])
+        ax_s = fig.add_subplot(gs[2], projection="3d")
+        z = self.view.section_z_um
+        self._images = []
+        for ax, cmap, label, title in (
+            (ax_t, self.cmap, "T [C]", f"temperature at z = {z:.0f} um (cyan: melt)"),
+            (ax_l, matplotlib.colormaps["Blues"], "liquid fraction", "liquid fraction"),
+        ):
+            im = ax.imshow(
+                np.ma.masked_all((2, 2)),
+                cmap=cmap,
+                origin="lower",
+                extent=(xmin, xmax, ymin, ymax),
+                interpolation="nearest",
+            )
+            fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03)
+            ax.set_xlim(xmin, xmax)
+            ax.set_ylim(ymin, ymax)
+            ax.set_aspect("equal", adjustable="box")
+            ax.set_xlabel("x [um]")
+            ax.set_ylabel("y [um]")
+            ax.set_title(title, fontsize=9)
+            self._images.append(im)
+        self._images[1].set_clim(0.0, 1.0)
+        # the solver's (x, y up, z) shown as the plot's (x, z, y): up is up
+        ax_s.set_xlim(xmin, xmax)
+        ax_s.set_ylim(zmin, zmax)
+        ax_s.set_zlim(ymin, ymax)
+        ax_s.set_box_aspect((xmax - xmin, zmax - zmin, ymax - ymin))
+        ax_s.view_init(elev=VIEW_ELEV_DEG, azim=VIEW_AZIM_DEG)
+        ax_s.set_xlabel("x [um]", fontsize=8)
+        ax_s.set_ylabel("z [um]", fontsize=8)
+        ax_s.set_zlabel("y [um]", fontsize=8)
+        ax_s.tick_params(labelsize=7)
+        ax_s.set_title("surface, lit, by temperature", fontsize=9)
+        self._ax_t, self._ax_s = ax_t, ax_s
+        self._contour = self._mesh = None
+        self._fig = fig
+
+    def draw(self, t_s: float, grid: ColourGrid, surf: Surface, T_points: np.ndarray) -> None:
+        """Frame at ``t_s`` from the colour ``grid`` (sums of T_C and liquid_fraction), its
+        surface ``surf`` and the points' temperatures (the colour limits)."""
+        if self._fig is None:
+            self._setup()
+        k = int(round((self.view.section_z_um - grid.lo[2]) / grid.spacing))
+        k = min(max(k, 0), grid.c.shape[2] - 1)
+        c = grid.c[:, :, k].T  # (ny, nx): image rows are y
+        material = c >= SURFACE_LEVEL
+        T = grid.value("T_C")[:, :, k].T
+        lf = grid.value("liquid_fraction")[:, :, k].T
+        h = grid.spacing
+        extent = (
+            grid.lo[0] - h / 2,
+            grid.lo[0] + (c.shape[1] - 0.5) * h,
+            grid.lo[1] - h / 2,
+            grid.lo[1] + (c.shape[0] - 0.5) * h,
+        )
+        clim = _finite_range(np.asarray(T_points, dtype=float), hi=self.melt_C)
+        for im, v in zip(self._images, (T, lf), strict=True):
+            im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
+            im.set_extent(extent)
+        self._images[0].set_clim(*clim)
+        for artist in (self._contour, self._mesh):
+            if artist is not None:
+                with contextlib.suppress(Exception):
+                    artist.remove()
+        self._contour = self._mesh = None
+        melt = np.where(material, np.nan_to_num(lf, nan=0.0), 0.0)
+        if (melt > MELT_LEVEL).any():
+            xs = grid.lo[0] + h * np.arange(c.shape[1])
+            ys = grid.lo[1] + h * np.arange(c.shape[0])
+            with contextlib.suppress(Exception):  # the outline is decoration
+                self._contour = self._ax_t.contour(
+                    xs, ys, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
+                )
+        if len(surf.tris):
+            colour = self.cmap(Normalize(*clim)(surf.values["T_C"][surf.tris].mean(axis=1)))
+            colour[:, :3] *= shade(surf.normals())[:, None]
+            self._mesh = Poly3DCollection(
+                surf.verts[surf.tris][:, :, [0, 2, 1]], facecolors=colour, linewidths=0.0
+            )
+            self._ax_s.add_collection3d(self._mesh)
+        self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
+
+    def save(self, path: Path, dpi: int) -> None:
+        save_png(self._fig, path, dpi)
+
+    def close(self) -> None:
+        self._fig = None
