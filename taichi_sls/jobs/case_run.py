@@ -28,10 +28,10 @@ from ..config.layer_file import CARRIED_STATE, OPTIONAL_STATE
 from ..io.bed_outcome_plot import plot_bed_outcome
 from ..io.contacts_plot import plot_contacts
 from ..io.contacts_table import read_contacts, write_contacts
+from ..io.frames3d import view_3d
 from ..io.layer_output import write_layer
 from ..io.outcome_plot import plot_outcome
 from ..io.vtu import point_data
-from ..io.frames3d import view_3d
 from ..io.writer import OutputWriter
 from ..physics.materials import KELVIN
 from ..solver import compile_clock

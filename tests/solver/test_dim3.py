@@ -175,8 +175,8 @@ def test_slip_wall_in_z_stops_the_sphere_and_keeps_its_slide():
 
 @pytest.mark.slow
 def test_bundled_3d_case_runs_from_the_command_line(tmp_path):
-    """cases/sphere3d_heat.toml, shortened: the summary and time series of a 3D run (energies
-    in J), its frames and GIF; the sphere cools through the plate, and no point rises above the 200 C
+    """cases/sphere3d_heat.toml, shortened: the summary, time series, frames and GIF of a 3D
+    run (energies in J); the sphere cools through the plate, and no point rises above the 200 C
     it was seeded at (with the sub-grid filter's rate per the 3D thermal limit, its core rose
     to 200.15 C by 20 us)."""
     out = tmp_path / "run"
