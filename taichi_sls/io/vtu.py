@@ -98,7 +98,8 @@ class VtuWriter:
         for name, v in fields.items():
             if len(v) != len(x):  # a short array would shift every later tuple in ParaView
                 raise ValueError(f"frame {index}: {name} has {len(v)} tuples for {len(x)} points")
-        pts = _vector3(np.asarray(x, dtype=float).reshape(len(x), -1))
+        x = np.asarray(x, dtype=float)
+        pts = _vector3(x if x.ndim == 2 else x.reshape(-1, 2))
         cells = [("vertex", np.arange(len(x)).reshape(-1, 1))] if len(x) else []
         self._write("points", index, t_s, pts, cells, fields)
 
