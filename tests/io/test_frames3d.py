@@ -6,10 +6,12 @@ import re
 import imageio.v3 as iio
 import meshio
 import numpy as np
+from helpers import deep_update, make_case
 
 import taichi_sls as sls
-from taichi_sls.io.frames3d import LIGHT, shade
+from taichi_sls.io.frames3d import LIGHT, View3D, shade, view_3d
 from taichi_sls.io.surface3d import colour_grid, surface
+from taichi_sls.io.writer import OutputWriter
 from taichi_sls.jobs.case_run import run_case
 
 
@@ -85,3 +87,36 @@ def test_3d_run_writes_frames_gif_and_vtu_and_resume_keeps_them(tmp_path):
     T = surf.point_data["T_C"]
     assert 140.0 - 1e-6 <= T.min() and T.max() <= 200.0 + 1e-6  # between the plate and the melt
     assert set(surf.point_data) == {"T_C", "liquid_fraction"}
+
+
+def test_section_is_at_the_track_of_a_laser_along_x_else_mid_depth():
+    sphere = {
+        "domain": {"dim": 3, "width_um": 40.0, "height_um": 40.0, "depth_um": 32.0},
+        "bodies": [{"shape": "disc", "center_um": [20.0, 20.0, 16.0], "radius_um": 10.0}],
+        "physics": {"surface_tension": False},
+    }
+    assert view_3d(make_case(sphere)).section_z_um == 16.0
+    along_x = {"lasers": [{"power_W": 1.0, "z_start_um": 10.0}]}
+    assert view_3d(make_case(deep_update(sphere, along_x))).section_z_um == 10.0
+    v = view_3d(make_case(deep_update(sphere, {"grid": {"spacing_um": 4.0}})))
+    assert v.point_spacing_um == 2.0  # 2 points per cell
+    assert v.z_range_um[1] - v.z_range_um[0] > 32.0  # the ghost layer in z as in x
+
+
+def test_3d_frames_of_no_point_one_point_and_flung_points_are_written(tmp_path):
+    """A failed run's last frame may hold points flung off the grid or NaN: left out of the
+    colour grid, the frame and the VTU are still written (the points VTU keeps them all)."""
+    w = OutputWriter(
+        tmp_path, domain_um=(0, 20, 0, 20), melt_C=175.0, vtu=True, view3d=View3D((0, 20), 1, 10)
+    )
+    states = [
+        np.zeros((0, 3)),
+        np.array([[5.0, 5.0, 5.0]]),
+        np.array([[np.nan, 5.0, 5.0], [1e30, 0.0, 0.0], [5.0, 5.0, 5.0]]),
+    ]
+    for i, x in enumerate(states):
+        w.frame(i, 0.0, x, np.full(len(x), 150.0), np.zeros(len(x)), np.zeros(len(x)))
+    w.finish()
+    assert len(list((tmp_path / "frames").glob("frame_*.png"))) == 3
+    assert meshio.read(tmp_path / "vtu" / "points_0002.vtu").points.shape == (3, 3)
+    assert (tmp_path / "animation.gif").is_file()
