@@ -62,6 +62,21 @@ def view_3d(case: Any) -> View3D:
     return View3D((-ghost, depth + ghost), g.spacing_um / g.points_per_cell, float(z))
 
 
+def section_layer(
+    case: Any, x_initial: np.ndarray, x_final: np.ndarray, body: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """outcome.png of a 3D run (io/outcome_plot.py draws points in a plane): the points seeded
+    in the lattice layer nearest the frames' section (z of :func:`view_3d`), their x and y at
+    the start and the end, and their bodies. A 2D run's points as they are."""
+    if case.domain.dim == 2:
+        return x_initial, x_final, body
+    v = view_3d(case)
+    a = v.point_spacing_um * 1e-6
+    z = (np.round(v.section_z_um * 1e-6 / a - 0.5) + 0.5) * a  # the layer's seeded z
+    layer = np.abs(x_initial[:, 2] - z) < 0.25 * a
+    return x_initial[layer, :2], x_final[layer, :2], body[layer]
+
+
 def section(
     grid: ColourGrid, z_um: float
 ) -> tuple[np.ndarray, list[np.ndarray], np.ndarray, np.ndarray]:

@@ -72,6 +72,7 @@ def test_3d_run_writes_frames_gif_and_vtu_and_resume_keeps_them(tmp_path):
     im = iio.imread(frames[-1])[..., :3]
     assert im.std() > 10  # not blank
     assert iio.imread(out / "animation.gif").shape[0] == 3
+    assert iio.imread(out / "outcome.png")[..., :3].std() > 10  # from the mid-depth layer
     for name in ("points", "surface"):
         assert _pvd_files(out / f"{name}.pvd") == [f"vtu/{name}_{i:04d}.vtu" for i in range(3)]
     pts = meshio.read(out / "vtu" / "points_0002.vtu")
