@@ -1,8 +1,8 @@
 """Frame images of a 3D run, drawn on the CPU with matplotlib alone (no GPU, no PyVista):
 
 1. the temperature on a section through the material (the x-y plane at ``section_z_um``: the
-   laser's track if it scans along x, else the mid-depth; y up as in the 2D frames), the melt
-   outlined (liquid fraction 1/2, cyan);
+   laser's track if it scans along x, else the mid-depth, across the tracks of a scan along z;
+   y up as in the 2D frames), the melt outlined (liquid fraction 1/2, cyan);
 2. the liquid fraction on the same section;
 3. the material's surface (colour c = 1/2, io/surface3d.py) in perspective, coloured by the
    temperature and lit by one distant light (Lambert: the colour times 0.3 + 0.7 cos of the
@@ -10,7 +10,8 @@
 
 The section and the surface are read off one colour grid of the point spacing
 (io/surface3d.colour_grid), so the section's material and the surface agree. One figure is
-reused across frames (headless Agg); only the artists change."""
+reused across frames (headless Agg); only the artists change. outcome.png of a 3D run draws
+the points seeded in the lattice layer at that section (:func:`section_layer`)."""
 
 from __future__ import annotations
 
