@@ -149,11 +149,3 @@ def _refuse_in_3d(case: Any) -> None:
             f'solver.layout = "blocks" with domain.dim = 3: the race-free colouring is 4 '
             f'colours of 2D blocks, {not_yet}; allowed in 3D: "auto", "serial", "parallel"'
         )
-    out = case.output
-    for key in ("png", "gif", "vtu"):
-        if key in out.model_fields_set and getattr(out, key):
-            raise CaseError(
-                f"output.{key} = true with domain.dim = 3: frames are {not_yet}; "
-                "allowed in 3D: false (the time series and summary are written)"
-            )
-        setattr(out, key, False)  # the 2D defaults (png, gif on) do not apply
