@@ -42,6 +42,7 @@ from ..physics.mechanics import (
     p2g_mechanics,
     p2g_momentum,
 )
+from ..physics.mirror import fold_after_p2g, fold_before_update
 from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
@@ -349,9 +350,11 @@ def advance_clock(st: ti.template(), heat: ti.template(), geom: ti.template()):
 STAGES = (
     clear_grid,
     p2g,
+    fold_after_p2g,
     grid_temperature_stage,
     surface_force,
     heat_flux,
+    fold_before_update,
     grid_update,
     g2p,
     advance_clock,
