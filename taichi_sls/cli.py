@@ -8,7 +8,8 @@
                      neck (the melted-pair study), refinement (the paper's cases under grid and
                      dt refinement), packing3d (the 3D bed generator's packing fraction),
                      process (a PA12 layer's density against energy density and bed
-                     temperature, and its sensitivities)
+                     temperature, and its sensitivities), symmetry (a 3D pair's quarter under
+                     two mirror walls against the full domain), speed3d (explicit 3D throughput)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -149,6 +150,7 @@ def parser() -> argparse.ArgumentParser:
         robustness,
         sinter_hold,
         speed,
+        symmetry,
     )
     from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
@@ -164,7 +166,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d, process",
+        "paper, neck, refinement, packing3d, process, symmetry",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -180,6 +182,7 @@ def parser() -> argparse.ArgumentParser:
         refinement,
         bed3d_packing,
         process_study,
+        symmetry,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)
