@@ -150,6 +150,7 @@ def parser() -> argparse.ArgumentParser:
         robustness,
         sinter_hold,
         speed,
+        speed3d,
         symmetry,
     )
     from .studies.process import study as process_study
@@ -166,7 +167,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d, process, symmetry",
+        "paper, neck, refinement, packing3d, process, symmetry, speed3d",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -183,6 +184,7 @@ def parser() -> argparse.ArgumentParser:
         bed3d_packing,
         process_study,
         symmetry,
+        speed3d,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)
