@@ -7,8 +7,8 @@ energy, heat, plasticity); about n points. Each size runs in the layout ``solver
 "auto"`` picks, then the serial layout (one thread) and the parallel layout (every core) side
 by side, and the serial layout without surface tension (the surface energy's share of a step).
 Each row gives wall (the fastest call's) and process CPU seconds per step, point-steps per
-second of each, and the bytes of Taichi fields per point. On a GPU (``--arch gpu``) the parallel layout alone runs (the
-serial one is a CPU layout). Writes speed3d.csv and speed3d.json.
+second of each, and the bytes of Taichi fields per point. On a GPU (``--arch gpu``) the
+parallel layout alone runs (the serial one is a CPU layout). Writes speed3d.csv and speed3d.json.
 """
 
 from __future__ import annotations
