@@ -2,6 +2,7 @@
 
     clear_grid     over the active region (grown at the end of G2P to hold every point)
     p2g            mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; eq. 21**
+    (fold_after_p2g, and fold_before_update before grid_update: mirror walls, physics/mirror.py)
     grid_temperature  node temperature (fixed-temperature walls)*
     surface_force  level set and curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
     heat_flux      grad T_p, conduction and laser heat rates (eqs. 29-31)*
