@@ -8,7 +8,8 @@
                      neck (the melted-pair study), refinement (the paper's cases under grid and
                      dt refinement), packing3d (the 3D bed generator's packing fraction),
                      process (a PA12 layer's density against energy density and bed
-                     temperature, and its sensitivities)
+                     temperature, and its sensitivities), symmetry (a 3D pair's quarter under
+                     two mirror walls against the full domain), speed3d (explicit 3D throughput)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -150,6 +151,8 @@ def parser() -> argparse.ArgumentParser:
         robustness,
         sinter_hold,
         speed,
+        speed3d,
+        symmetry,
     )
     from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
@@ -165,7 +168,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, implicit3d, hold, window, "
-        "accuracy, paper, neck, refinement, packing3d, process",
+        "accuracy, paper, neck, refinement, packing3d, process, symmetry, speed3d",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -182,6 +185,8 @@ def parser() -> argparse.ArgumentParser:
         refinement,
         bed3d_packing,
         process_study,
+        symmetry,
+        speed3d,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)
