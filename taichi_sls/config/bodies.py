@@ -52,6 +52,24 @@ class Disc(BodyBase):
         return 4 * math.pi * self.radius_um**2
 
 
+class Cylinder(BodyBase):
+    """3D only: a disc extruded along z across the whole depth (with a periodic depth, an
+    infinite cylinder; config/periodic.py)."""
+
+    shape: Literal["cylinder"] = Field(description="disc, rect, polygon or points")
+    axis_um: Pair = Field(
+        [20.0, 20.0], description="the axis' [x, y] (um); the cylinder runs along z"
+    )
+    radius_um: float = Field(20.0, gt=0, description="cylinder radius (um)")
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        r = self.radius_um
+        return tuple(c - r for c in self.axis_um), tuple(c + r for c in self.axis_um)
+
+    def perimeter_um(self) -> float:
+        return 2 * math.pi * self.radius_um
+
+
 class Rect(BodyBase):
     shape: Literal["rect"] = Field(description="disc, rect, polygon or points")
     min_um: Point = Field(
@@ -157,4 +175,4 @@ class LayerBody(BodyBase):
         return 2.0 * math.sqrt(math.pi * float(np.sum(self.points_um()[1])))
 
 
-Body = Annotated[Disc | Rect | Polygon | LayerBody, Field(discriminator="shape")]
+Body = Annotated[Disc | Cylinder | Rect | Polygon | LayerBody, Field(discriminator="shape")]

@@ -64,8 +64,10 @@ class Domain(Model):
 
 
 class Wall(Model):
-    mechanical: Literal["slip", "stick", "open"] = Field(
-        "slip", description="slip: zero normal velocity"
+    mechanical: Literal["slip", "stick", "open", "periodic"] = Field(
+        "slip",
+        description="slip: zero normal velocity; periodic: front and back (3D) together, z wraps "
+        "with the period depth_um (config/periodic.py)",
     )
     thermal: Literal["insulated", "fixed"] = Field("insulated", description="heat flux condition")
     temperature_C: float = Field(140.0, description="wall temperature when thermal = fixed")

@@ -24,6 +24,7 @@ class WallMechanical(IntEnum):
     SLIP = 0  # zero normal velocity
     STICK = 1  # zero velocity
     OPEN = 2  # no condition
+    PERIODIC = 3  # 3D front and back only: z wraps (solver/periodic.py); no condition at a wall
 
 
 class ViscosityModel(IntEnum):

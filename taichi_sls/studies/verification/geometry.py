@@ -59,14 +59,18 @@ def hopper_radius_um(data: dict) -> float:
 
 def hopper_geometry(data: dict, R0_over_h: float) -> None:
     """Hopper's pair at R0/h (raw case data, in place): domain 4 R0 + 12 h by 3 R0 + 12 h (the
-    final circle has radius sqrt(2) R0), the mid-plane on a node line or through cell centres
-    (verification.hopper_midplane), the line of centres 0.377 h off the node rows. tau0 = 0: two
-    touching discs; tau0 > 0: the outline at tau0 as a polygon of 1024 vertices."""
+    final circle has radius sqrt(2) R0; turned by ``hopper_angle_deg``, the box that holds the
+    turned pair), the mid-plane on a node line or through cell centres
+    (verification.hopper_midplane), the line of centres 0.377 h off the node rows and turned by
+    hopper_angle_deg about the neck. tau0 = 0: two touching discs; tau0 > 0: the outline at tau0
+    as a polygon of 1024 vertices."""
     v = data.setdefault("verification", {})
     R0 = hopper_radius_um(data)
     h = R0 / R0_over_h
-    W = h * math.ceil((4 * R0 + 12 * h) / h - 1e-9)
-    H = h * math.ceil((3 * R0 + 12 * h) / h - 1e-9)
+    turn = math.radians(float(v.get("hopper_angle_deg", 0.0)))
+    cos, sin = abs(math.cos(turn)), abs(math.sin(turn))
+    W = h * math.ceil((max(4 * cos + 2 * sin, 3.0) * R0 + 12 * h) / h - 1e-9)
+    H = h * math.ceil((max(4 * sin + 2 * cos, 3.0) * R0 + 12 * h) / h - 1e-9)
     X = h * round(W / (2 * h)) + (0.5 * h if v.get("hopper_midplane", "node") == "cell" else 0.0)
     Y = H / 2 + 0.377 * h
     data["grid"]["spacing_um"] = h
@@ -74,10 +78,23 @@ def hopper_geometry(data: dict, R0_over_h: float) -> None:
     mat = data["bodies"][0].get("material", "PA12")
     tau0 = float(v.get("hopper_tau0", 0.0))
     if tau0 > 0.0:
-        outline = ref.hopper_outline(ref.hopper_nu(tau0), R0, 1024, (X, Y))
-        data["bodies"] = [{"shape": "polygon", "vertices_um": outline.tolist(), "material": mat}]
+        outline = ref.hopper_outline(ref.hopper_nu(tau0), R0, 1024, (0.0, 0.0))
+        c, s = math.cos(turn), math.sin(turn)
+        xy = (
+            np.stack(
+                [
+                    X + c * outline[:, 0] - s * outline[:, 1],
+                    Y + s * outline[:, 0] + c * outline[:, 1],
+                ],
+                axis=1,
+            )
+            if turn != 0.0
+            else outline + np.array([X, Y])
+        )
+        data["bodies"] = [{"shape": "polygon", "vertices_um": xy.tolist(), "material": mat}]
     else:
+        dx, dy = R0 * math.cos(turn), R0 * math.sin(turn)
         data["bodies"] = [
-            {"shape": "disc", "center_um": [X - R0, Y], "radius_um": R0, "material": mat},
-            {"shape": "disc", "center_um": [X + R0, Y], "radius_um": R0, "material": mat},
+            {"shape": "disc", "center_um": [X - dx, Y - dy], "radius_um": R0, "material": mat},
+            {"shape": "disc", "center_um": [X + dx, Y + dy], "radius_um": R0, "material": mat},
         ]
