@@ -32,7 +32,7 @@ def hopper_frame(case: Case) -> tuple[float, np.ndarray, float]:
     the middle of its extent, the angle that of its farthest vertex from the centre)."""
     b = case.bodies
     if b[0].shape in ("disc", "cylinder"):
-        a, c = (np.asarray(x.center_um[:2], dtype=float) for x in b[:2])
+        a, c = (np.asarray(getattr(x, "center_um", None) or x.axis_um, dtype=float) for x in b[:2])
         d = c - a
         return b[0].radius_um * 1e-6, 0.5e-6 * (a + c), math.atan2(d[1], d[0])
     v = np.asarray(b[0].outline_um(), dtype=float)
@@ -66,7 +66,13 @@ def midplane_section(sim, case: Case) -> float:
     3D the mean over the node layers of the periodic depth (each an x-y section)."""
     _, centre, turn = hopper_frame(case)
     cfg = sim.state.cfg
-    c = sim.colour()
+    if cfg.dim == 3:
+        from ...solver.periodic_views import periodic_colour
+
+        periodic_colour(sim.state)
+        c = sim.node_arrays()["colour"]
+    else:
+        c = sim.colour()
     layers = [c] if c.ndim == 2 else [c[:, :, cfg.off + k] for k in range(cfg.ncz)]
     if turn == 0.0:
         return float(np.mean([colour_section(cl, cfg.h, cfg.off, centre[0]) for cl in layers]))
