@@ -135,3 +135,42 @@ def test_a_cylinder_runs_across_the_depth():
     assert len(layers) == 8  # two point layers per cell
     count = [(np.abs(x[:, 2] - z) < 1e-6).sum() for z in layers]
     assert len(set(count)) == 1
+
+
+def _heat_run(hot, cold):
+    ins = {w: {"thermal": "insulated"} for w in SIDES}
+    rows = [(r, 200.0) for r in hot] + [(r, 150.0) for r in cold]
+    d = {
+        "grid": {"spacing_um": 2.0},
+        "domain": {"dim": 3, "width_um": 8.0, "height_um": 8.0, "depth_um": 16.0},
+        "bodies": [
+            {"shape": "rect", "min_um": [0, 0, a], "max_um": [8, 8, b], "temperature_C": T}
+            for (a, b), T in rows
+        ],
+        "physics": {"surface_tension": False, "mechanics": False},
+        "boundary": {**ins, **PERIODIC},
+    }
+    sim = Simulation(make_case(d))
+    pt = sim.state.points
+    H0 = (pt.enthalpy.to_numpy() * pt.mass.to_numpy()).sum()
+    sim.advance(400)
+    H1 = (pt.enthalpy.to_numpy() * pt.mass.to_numpy()).sum()
+    return pt.x.to_numpy(), pt.T.to_numpy(), H0, H1
+
+
+def test_periodic_heat_is_conserved_and_exact_across_the_seam():
+    """Heat only: a hot slab at 200 C between cold ones at 150 C (z 4..12 um of 16), and the
+    same shifted by D/2 so that the hot slab is cut by the seam; 400 steps: the enthalpy is
+    kept to round-off (measured 2e-16; bound 1e-12 as the 2D tests) while the slabs exchange
+    heat, and the two runs agree point by point (measured 1.7e-13 K; bound 1e-9 K)."""
+    xa, Ta, H0a, H1a = _heat_run([(4, 12)], [(0, 4), (12, 16)])
+    xb, Tb, H0b, H1b = _heat_run([(12, 16), (0, 4)], [(4, 12)])
+    assert abs(H1a / H0a - 1.0) < 1e-12 and abs(H1b / H0b - 1.0) < 1e-12
+    assert Ta.max() - Ta.min() < 10.0  # from 50 K apart: the heat did cross the seam
+    D = 16e-6
+    xs = xb.copy()
+    xs[:, 2] = np.mod(xb[:, 2] - 0.5 * D, D)
+    ia = np.lexsort((xa[:, 2], xa[:, 1], xa[:, 0]))
+    ib = np.lexsort((xs[:, 2], xs[:, 1], xs[:, 0]))
+    assert np.abs(xa[ia] - xs[ib]).max() < 1e-15
+    assert np.abs(Ta[ia] - Tb[ib]).max() < 1e-9
