@@ -113,6 +113,14 @@ STUDIES = (
         sets={"verification": {"hopper_midplane": "cell"}},
         case="hopper",
     ),
+    Study(  # the 2D counterpart of hopper3d_45deg
+        "hopper_45deg",
+        (10, 20),
+        (10,),
+        "neck_tau1",
+        sets={"verification": {"hopper_angle_deg": 45.0}},
+        case="hopper",
+    ),
     Study("hopper_shape", (10, 20), (), "neck_tau1"),
     Study(  # from Hopper's outline at tau0 = 0.5, beside the same pair turned by 45 deg
         "hopper_shape_tau0.5",
