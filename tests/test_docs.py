@@ -37,7 +37,7 @@ def _known(section: str, key: str) -> bool:
         "boundary": (Wall,),
         "bed": (Bed,),
     }.get(section, (ann,))
-    if section == "boundary" and key in ("left", "right", "bottom", "top"):
+    if section == "boundary" and key in ("left", "right", "bottom", "top", "front", "back"):
         return True
     if section in ("materials", "lasers", "bodies") and (key.isdigit() or key.isupper()):
         return True

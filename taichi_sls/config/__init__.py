@@ -2,7 +2,7 @@
 key reference. The lowest layer: it imports nothing else of the package."""
 
 from .bed import Bed
-from .bodies import Body, Disc, Polygon, Rect
+from .bodies import Body, Cylinder, Disc, Polygon, Rect
 from .errors import CaseError
 from .loading import (
     apply_override,
@@ -23,6 +23,7 @@ __all__ = [
     "Body",
     "Case",
     "CaseError",
+    "Cylinder",
     "Disc",
     "Material",
     "Polygon",

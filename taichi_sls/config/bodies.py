@@ -26,7 +26,7 @@ class BodyBase(Model):
 
 
 class Disc(BodyBase):
-    shape: Literal["disc"] = Field("disc", description="disc, rect, polygon or points")
+    shape: Literal["disc"] = Field("disc", description="disc, cylinder, rect, polygon or points")
     center_um: Point = Field(
         [20.0, 20.0], description="disc centre (um); [x, y] in 2D, [x, y, z] in 3D (a sphere)"
     )
@@ -52,8 +52,27 @@ class Disc(BodyBase):
         return 4 * math.pi * self.radius_um**2
 
 
+class Cylinder(BodyBase):
+    """3D only: a disc extruded along z across the whole depth (with a periodic depth, an
+    infinite cylinder; config/periodic.py)."""
+
+    shape: Literal["cylinder"] = Field(description="disc, cylinder, rect, polygon or points")
+    axis_um: Pair = Field(
+        [20.0, 20.0],
+        description="3D only: the axis' [x, y] (um); a disc extruded along z across the depth",
+    )
+    radius_um: float = Field(20.0, gt=0, description="cylinder radius (um)")
+
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        r = self.radius_um
+        return tuple(c - r for c in self.axis_um), tuple(c + r for c in self.axis_um)
+
+    def perimeter_um(self) -> float:
+        return 2 * math.pi * self.radius_um
+
+
 class Rect(BodyBase):
-    shape: Literal["rect"] = Field(description="disc, rect, polygon or points")
+    shape: Literal["rect"] = Field(description="disc, cylinder, rect, polygon or points")
     min_um: Point = Field(
         [0.0, 0.0], description="rectangle lower-left corner (um); [x, y, z] in 3D (a box)"
     )
@@ -74,7 +93,7 @@ class Rect(BodyBase):
 
 
 class Polygon(BodyBase):
-    shape: Literal["polygon"] = Field(description="disc, rect, polygon or points")
+    shape: Literal["polygon"] = Field(description="disc, cylinder, rect, polygon or points")
     vertices_um: list[Pair] = Field(
         [],
         description="outline vertices [[x, y], ...] (um), in order, either sense; or give "
@@ -119,7 +138,7 @@ class LayerBody(BodyBase):
     where the file carries them their deformation and stress), placed at rest; the case's
     ``bed.previous_layer`` lists one per body."""
 
-    shape: Literal["points"] = Field(description="disc, rect, polygon or points")
+    shape: Literal["points"] = Field(description="disc, cylinder, rect, polygon or points")
     file: str = Field(description="layer file (layer.npz of a bed run), relative to the case file")
     body: int = Field(0, ge=0, description="which body of the layer file")
 
@@ -157,4 +176,4 @@ class LayerBody(BodyBase):
         return 2.0 * math.sqrt(math.pi * float(np.sum(self.points_um()[1])))
 
 
-Body = Annotated[Disc | Rect | Polygon | LayerBody, Field(discriminator="shape")]
+Body = Annotated[Disc | Cylinder | Rect | Polygon | LayerBody, Field(discriminator="shape")]

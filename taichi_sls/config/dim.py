@@ -8,12 +8,14 @@ from __future__ import annotations
 from typing import Any
 
 from .errors import CaseError
+from .periodic import check_periodic
 from .sections import Wall
 
 
 def check_dimension(case: Any) -> None:
     """Refuse what ``case.domain.dim`` cannot run; called before any other cross-check."""
     dim = case.domain.dim
+    check_periodic(case)  # config/periodic.py: the periodic depth and the cylinder
     _check_coordinates(case, dim)
     if dim == 2:
         # a wall in z set away from its default (a dumped 2D case carries the defaults)

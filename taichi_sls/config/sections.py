@@ -64,10 +64,11 @@ class Domain(Model):
 
 
 class Wall(Model):
-    mechanical: Literal["slip", "stick", "open", "mirror"] = Field(
+    mechanical: Literal["slip", "stick", "open", "mirror", "periodic"] = Field(
         "slip",
         description="slip: zero normal velocity; mirror: a plane of symmetry (slip, insulated, "
-        "no surface at the plane; the case is the half of a symmetric scene)",
+        "no surface at the plane; the case is the half of a symmetric scene); periodic: front "
+        "and back (3D) together, z wraps with the period depth_um (config/periodic.py)",
     )
     thermal: Literal["insulated", "fixed"] = Field("insulated", description="heat flux condition")
     temperature_C: float = Field(140.0, description="wall temperature when thermal = fixed")

@@ -25,6 +25,7 @@ class WallMechanical(IntEnum):
     STICK = 1  # zero velocity
     OPEN = 2  # no condition
     MIRROR = 3  # a plane of symmetry: zero normal velocity, ghosts mirrored (physics/mirror.py)
+    PERIODIC = 4  # 3D front and back only: z wraps (solver/periodic.py); no condition at a wall
 
 
 class ViscosityModel(IntEnum):

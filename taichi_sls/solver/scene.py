@@ -101,6 +101,8 @@ def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
                 cos = d[:, 0] / np.sqrt(np.maximum(r2, 1e-300))
                 R = R * (1.0 + b.perturbation * legendre.legval(cos, [0.0] * b.mode + [1.0]))
             inside = r2 < R**2
+        elif b.shape == "cylinder":  # a disc extruded along z (config/periodic.py)
+            inside = ((P[:, :2] - np.asarray(b.axis_um)) ** 2).sum(axis=1) < b.radius_um**2
         else:
             inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
         owner[(owner == -1) & inside] = bi

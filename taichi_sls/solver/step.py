@@ -68,6 +68,7 @@ from .loops import (
     top_loss_in_order,
     wall_heat_in_order,
 )
+from .periodic import with_periodic
 
 
 @ti.func
@@ -360,6 +361,7 @@ STAGES = (
     g2p,
     advance_clock,
 )
+STAGES = with_periodic(STAGES, grid_temperature_stage, grid_update)  # solver/periodic.py
 SURFACE = STAGES.index(surface_force)
 
 

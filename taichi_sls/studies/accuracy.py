@@ -113,10 +113,44 @@ STUDIES = (
         sets={"verification": {"hopper_midplane": "cell"}},
         case="hopper",
     ),
+    Study(  # the 2D counterpart of hopper3d_45deg
+        "hopper_45deg",
+        (10, 20),
+        (10,),
+        "neck_tau1",
+        sets={"verification": {"hopper_angle_deg": 45.0}},
+        case="hopper",
+    ),
     Study("hopper_shape", (10, 20), (), "neck_tau1"),
+    Study(  # from Hopper's outline at tau0 = 0.5, beside the same pair turned by 45 deg
+        "hopper_shape_tau0.5",
+        (10, 20),
+        (),
+        "neck_tau1",
+        sets={"verification": {"hopper_tau0": 0.5}},
+        case="hopper_shape",
+    ),
+    Study(
+        "hopper_shape_45deg",
+        (10, 20),
+        (),
+        "neck_tau1",
+        sets={"verification": {"hopper_tau0": 0.5, "hopper_angle_deg": 45.0}},
+        case="hopper_shape",
+    ),
     Study("hopper_pa12", (10, 20), (10,), "neck_tau1"),  # the implicit integrator's
     Study("laplace3d", (10,), (10,), "pressure", on_request=True),
     Study("inviscid3d", (10,), (10,), "period", on_request=True),
+    Study("hopper3d", (10,), (10,), "neck_tau1", on_request=True),  # 2 cells of periodic depth
+    Study(
+        "hopper3d_45deg",
+        (10,),
+        (10,),
+        "neck_tau1",
+        sets={"verification": {"hopper_angle_deg": 45.0}},
+        case="hopper3d",
+        on_request=True,
+    ),
 )
 
 

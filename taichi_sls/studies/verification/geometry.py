@@ -48,7 +48,7 @@ def hopper_radius_um(data: dict) -> float:
     """R0 of a Hopper case (raw case data): the discs' radius, or for an outline the radius of
     each of two discs of its area."""
     b = data["bodies"][0]
-    if b.get("shape", "disc") == "disc":
+    if b.get("shape", "disc") in ("disc", "cylinder"):
         return float(b["radius_um"])
     from ...config import Polygon
 
@@ -57,27 +57,63 @@ def hopper_radius_um(data: dict) -> float:
     return round(math.sqrt(abs(ref.polygon_area(v)) / (2.0 * math.pi)), 3)
 
 
+def _depth_cells(data: dict) -> int:
+    """Cells across the depth of a 3D Hopper case file (its depth_um over its spacing_um); 0 in
+    2D."""
+    d = data.get("domain", {})
+    if d.get("dim", 2) != 3:
+        return 0
+    return max(1, round(float(d["depth_um"]) / float(data["grid"]["spacing_um"])))
+
+
 def hopper_geometry(data: dict, R0_over_h: float) -> None:
     """Hopper's pair at R0/h (raw case data, in place): domain 4 R0 + 12 h by 3 R0 + 12 h (the
-    final circle has radius sqrt(2) R0), the mid-plane on a node line or through cell centres
-    (verification.hopper_midplane), the line of centres 0.377 h off the node rows. tau0 = 0: two
-    touching discs; tau0 > 0: the outline at tau0 as a polygon of 1024 vertices."""
+    final circle has radius sqrt(2) R0; turned by ``hopper_angle_deg``, the box that holds the
+    turned pair), the mid-plane on a node line or through cell centres
+    (verification.hopper_midplane), the line of centres 0.377 h off the node rows and turned by
+    hopper_angle_deg about the neck. tau0 = 0: two touching discs; tau0 > 0: the outline at tau0
+    as a polygon of 1024 vertices. A 3D case (cases/verification/hopper3d.toml): two touching
+    cylinders along a periodic depth of the file's cells, the same pair in every x-y section."""
     v = data.setdefault("verification", {})
     R0 = hopper_radius_um(data)
     h = R0 / R0_over_h
-    W = h * math.ceil((4 * R0 + 12 * h) / h - 1e-9)
-    H = h * math.ceil((3 * R0 + 12 * h) / h - 1e-9)
+    turn = math.radians(float(v.get("hopper_angle_deg", 0.0)))
+    cos, sin = abs(math.cos(turn)), abs(math.sin(turn))
+    W = h * math.ceil((max(4 * cos + 2 * sin, 3.0) * R0 + 12 * h) / h - 1e-9)
+    H = h * math.ceil((max(4 * sin + 2 * cos, 3.0) * R0 + 12 * h) / h - 1e-9)
     X = h * round(W / (2 * h)) + (0.5 * h if v.get("hopper_midplane", "node") == "cell" else 0.0)
     Y = H / 2 + 0.377 * h
+    depth_cells = _depth_cells(data)
     data["grid"]["spacing_um"] = h
     data["domain"] = {"width_um": W, "height_um": H}
     mat = data["bodies"][0].get("material", "PA12")
+    if depth_cells:  # 3D: two cylinders along a periodic depth of as many cells as the file's
+        data["domain"].update(dim=3, depth_um=depth_cells * h)
+        dx, dy = R0 * math.cos(turn), R0 * math.sin(turn)
+        data["bodies"] = [
+            {"shape": "cylinder", "axis_um": [X - dx, Y - dy], "radius_um": R0, "material": mat},
+            {"shape": "cylinder", "axis_um": [X + dx, Y + dy], "radius_um": R0, "material": mat},
+        ]
+        return
     tau0 = float(v.get("hopper_tau0", 0.0))
     if tau0 > 0.0:
-        outline = ref.hopper_outline(ref.hopper_nu(tau0), R0, 1024, (X, Y))
-        data["bodies"] = [{"shape": "polygon", "vertices_um": outline.tolist(), "material": mat}]
+        outline = ref.hopper_outline(ref.hopper_nu(tau0), R0, 1024, (0.0, 0.0))
+        c, s = math.cos(turn), math.sin(turn)
+        xy = (
+            np.stack(
+                [
+                    X + c * outline[:, 0] - s * outline[:, 1],
+                    Y + s * outline[:, 0] + c * outline[:, 1],
+                ],
+                axis=1,
+            )
+            if turn != 0.0
+            else outline + np.array([X, Y])
+        )
+        data["bodies"] = [{"shape": "polygon", "vertices_um": xy.tolist(), "material": mat}]
     else:
+        dx, dy = R0 * math.cos(turn), R0 * math.sin(turn)
         data["bodies"] = [
-            {"shape": "disc", "center_um": [X - R0, Y], "radius_um": R0, "material": mat},
-            {"shape": "disc", "center_um": [X + R0, Y], "radius_um": R0, "material": mat},
+            {"shape": "disc", "center_um": [X - dx, Y - dy], "radius_um": R0, "material": mat},
+            {"shape": "disc", "center_um": [X + dx, Y + dy], "radius_um": R0, "material": mat},
         ]

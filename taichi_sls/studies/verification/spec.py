@@ -96,6 +96,14 @@ class VerificationSpec(Model):
     hopper_taus: list[float] = Field(
         [0.5, 1.0, 2.0, 3.0], description="hopper: the tau at which r_n / R0 is compared"
     )
+    hopper_angle_deg: float = Field(
+        0.0,
+        ge=-180,
+        le=180,
+        description="hopper at a resolution (verification.load): the line of centres turned by "
+        "this angle from x in the x-y plane, about the neck (the neck read on the turned "
+        "mid-plane); 0: along x",
+    )
     hopper_midplane: Literal["node", "cell"] = Field(
         "node",
         description="hopper at a resolution (verification.load): the mid-plane on a node line "
