@@ -44,6 +44,8 @@ class NeckMeasures:
         "auto"``: the colour for the surface-energy force, eq. 21 for the CSF and for frozen
         points), or the one the case names."""
         m = self.case.output.neck_measure
+        if self.state.cfg.dim == 3:  # eq. 21's level set is 2D: the colour, whatever the force
+            return "colour"
         if m == "auto":
             energy = self.case.surface_tension.method == "surface_energy"
             m = "colour" if energy and self.case.physics.mechanics else "level_set"
@@ -56,6 +58,8 @@ class NeckMeasures:
         if not self._pair:
             return float("nan"), float("nan")
         measure = measure or self.neck_measure()
+        if measure == "level_set" and self.state.cfg.dim == 3:
+            return float("nan"), float("nan")  # eq. 21's level set is 2D
         # 3D: the section across the centres (solver/section3d.py), a column has no meaning
         if self.case.contact.neck_section == "centres" or self.state.cfg.dim == 3:
             if not self.contacts:
