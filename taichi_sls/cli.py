@@ -149,6 +149,7 @@ def parser() -> argparse.ArgumentParser:
         robustness,
         sinter_hold,
         speed,
+        sphere_pair,
     )
     from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
@@ -164,7 +165,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d, process",
+        "paper, neck, refinement, packing3d, process, spherepair",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -180,6 +181,7 @@ def parser() -> argparse.ArgumentParser:
         refinement,
         bed3d_packing,
         process_study,
+        sphere_pair,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)
