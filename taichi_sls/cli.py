@@ -152,6 +152,7 @@ def parser() -> argparse.ArgumentParser:
         sinter_hold,
         speed,
         speed3d,
+        sphere_pair,
         symmetry,
     )
     from .studies.process import study as process_study
@@ -168,7 +169,7 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser(
         "bench",
         help="benchmarks and studies: speed, compile, cost, implicit, implicit3d, hold, window, "
-        "accuracy, paper, neck, refinement, packing3d, process, symmetry, speed3d",
+        "accuracy, paper, neck, refinement, packing3d, process, symmetry, speed3d, spherepair",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -187,6 +188,7 @@ def parser() -> argparse.ArgumentParser:
         process_study,
         symmetry,
         speed3d,
+        sphere_pair,
     ):
         module.add_parser(studies)
     robustness.add_parser(sub)

@@ -124,21 +124,6 @@ def _refuse_in_3d(case: Any) -> None:
             f"bed.previous_layer = {case.bed.previous_layer!r} with domain.dim = 3: layer files "
             f"are {not_yet}; allowed in 3D: a generated bed or bed.csv of spheres"
         )
-    if case.contact.initial == "fillet":
-        raise CaseError(
-            f'contact.initial = "fillet" with domain.dim = 3: the fillet bridge is {not_yet}; '
-            'allowed in 3D: "point"'
-        )
-    if case.contact.settle:
-        raise CaseError(
-            f"contact.settle = true with domain.dim = 3: settling reads the neck, {not_yet}; "
-            "allowed in 3D: false"
-        )
-    if case.time.stop == "solidified":
-        raise CaseError(
-            f'time.stop = "solidified" with domain.dim = 3: the fusion verdict reads neck '
-            f'sections, {not_yet}; allowed in 3D: "end"'
-        )
     if case.thermal.top_surface != "insulated":
         raise CaseError(
             f"thermal.top_surface = {case.thermal.top_surface!r} with domain.dim = 3: the loss "

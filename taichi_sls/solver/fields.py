@@ -295,16 +295,20 @@ class State:
 
     @ti.func
     def _prestress(self, p, p0):
-        """The elastic strain that carries an in-plane pressure p0 (plane strain, eps_zz = 0:
-        eps_xx = eps_yy = -p0 / 2 (lambda + mu)) at the point's initial moduli, and its stress
-        under the case's stress reading; finite strain: the elastic stretch Fe = exp(eps) of the
-        same strain, whose Hencky stress at J = 1 is the same."""
+        """The elastic strain that carries a pressure p0 (plane strain, eps_zz = 0:
+        eps_xx = eps_yy = -p0 / 2 (lambda + mu); 3D: -p0 / 3 K on each axis) at the point's
+        initial moduli, and its stress under the case's stress reading; finite strain: the
+        elastic stretch Fe = exp(eps) of the same strain, whose Hencky stress at J = 1 is the
+        same."""
         pt = ti.static(self.points)
         mp = self.materials[pt.material[p]]
         xi = pt.solid_fraction[p]
         E, nu = moduli(mp, xi)
         lam_mu = E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))  # lambda + mu
-        eps = ti.Matrix(IDENTITY[self.cfg.dim]) * (-p0 / (2.0 * lam_mu))
+        stiff = 2.0 * lam_mu  # plane strain: eps_xx = eps_yy = eps carries 2 (lambda + mu) eps
+        if ti.static(self.cfg.dim == 3):
+            stiff = E / (1.0 - 2.0 * nu)  # a sphere's isotropic eps carries 3 K eps
+        eps = ti.Matrix(IDENTITY[self.cfg.dim]) * (-p0 / stiff)
         pt.strain[p] = eps
         for a in ti.static(range(self.cfg.dim)):
             pt.elastic_stretch[p][a, a] = ti.exp(eps[a, a])

@@ -13,7 +13,7 @@ from .step import STAGES, SURFACE, grow_box_all, p2g
 
 @ti.kernel
 def interface_fields(st: ti.template()):
-    """The level set of eq. 21 and the surface-energy colour (nodes.phi, nodes.colour) of the
+    """The level set of eq. 21 (2D) and the surface-energy colour (nodes.phi, nodes.colour) of the
     current points, for monitors (also with surface tension off): one kernel for both (a
     kernel's compilation costs tens of ms whatever its size). The colour: the step's stages up
     to P2G without heat or geometry, then the colour (filtered as the case says). Leaves the
@@ -22,10 +22,11 @@ def interface_fields(st: ti.template()):
     for stage in ti.static(STAGES[: STAGES.index(p2g) + 1]):
         stage(st, False, False)
     colour_field(st.cfg, st.box, st.nodes)
-    for I in ti.grouped(ti.ndrange(*active(st.box))):
-        st.nodes.phi_raw[I] = st.cfg.phi_cap
-    point_loop(st, _level_set_body, False, True, True)
-    level_set(st.cfg, st.box, st.nodes, st.surf)
+    if ti.static(st.cfg.dim == 2):  # eq. 21's level set is 2D (the paper's CSF)
+        for I in ti.grouped(ti.ndrange(*active(st.box))):
+            st.nodes.phi_raw[I] = st.cfg.phi_cap
+        point_loop(st, _level_set_body, False, True, True)
+        level_set(st.cfg, st.box, st.nodes, st.surf)
 
 
 @ti.func

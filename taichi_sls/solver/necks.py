@@ -7,6 +7,7 @@ from . import struct_copy
 from .contacts import filtered_colour, neck_width, pair_reach, point_colour
 from .grid_views import interface_fields
 from .monitor import neck_measures
+from .section3d import filtered_colour_3d, neck_diameter, pair_reach_3d
 
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
 # own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
@@ -43,6 +44,8 @@ class NeckMeasures:
         "auto"``: the colour for the surface-energy force, eq. 21 for the CSF and for frozen
         points), or the one the case names."""
         m = self.case.output.neck_measure
+        if self.state.cfg.dim == 3:  # eq. 21's level set is 2D: the colour, whatever the force
+            return "colour"
         if m == "auto":
             energy = self.case.surface_tension.method == "surface_energy"
             m = "colour" if energy and self.case.physics.mechanics else "level_set"
@@ -55,7 +58,10 @@ class NeckMeasures:
         if not self._pair:
             return float("nan"), float("nan")
         measure = measure or self.neck_measure()
-        if self.case.contact.neck_section == "centres":
+        if measure == "level_set" and self.state.cfg.dim == 3:
+            return float("nan"), float("nan")  # eq. 21's level set is 2D
+        # 3D: the section across the centres (solver/section3d.py), a column has no meaning
+        if self.case.contact.neck_section == "centres" or self.state.cfg.dim == 3:
             if not self.contacts:
                 return 0.0, 0.0
             w = self.necks_m(measure)[0]
@@ -87,7 +93,9 @@ class NeckMeasures:
         """The colour a section across the centres reads, from a raw colour: the force's filter
         of it (``contact.neck_colour = "filtered"``, closing the notch along a node-line
         mid-plane) or itself (``"raw"``: the seeded outline, a concave neck unwidened)."""
-        return filtered_colour(raw) if self.case.contact.neck_colour == "filtered" else raw
+        if self.case.contact.neck_colour != "filtered":
+            return raw
+        return filtered_colour(raw) if raw.ndim == 2 else filtered_colour_3d(raw)
 
     def necks_m(self, measure: str | None = None) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``: the narrowest section
@@ -101,29 +109,31 @@ class NeckMeasures:
     def _contact_necks(self, field_of) -> list[float]:
         """neck_width of every contact on ``field_of(a, b)``, sampled out to
         :func:`~taichi_sls.solver.contacts.pair_reach`: the coalesced end state of the pair,
-        so a neck is followed past the bodies' initial diameter (issue #40 item 6)."""
+        so a neck is followed past the bodies' initial diameter (issue #40 item 6). 3D: the
+        diameter 2 sqrt(A / pi) of the section (solver/section3d.py, ``neck_diameter``)."""
         centre, r, cfg = self.body_centres_m(), self._body_radius, self.state.cfg
+        neck, reach = (neck_width, pair_reach) if cfg.dim == 2 else (neck_diameter, pair_reach_3d)
         return [
-            neck_width(
-                field_of(a, b), cfg.h, cfg.off, centre[a], centre[b], pair_reach(r[a], r[b])
-            )[0]
+            neck(field_of(a, b), cfg.h, cfg.off, centre[a], centre[b], reach(r[a], r[b]))[0]
             for a, b in self.contacts
         ]
 
     @property
     def body_radii_m(self) -> np.ndarray:
-        """Each body's equivalent radius sqrt(area / pi) as seeded (m): its reach for a neck."""
+        """Each body's equivalent radius as seeded (m), sqrt(area / pi) (3D: (3 V / 4 pi)^(1/3)):
+        its reach for a neck."""
         return self._body_radius
 
     def body_centres_m(self, initial: bool = False) -> np.ndarray:
-        """Each body's mass centre (m), (bodies, 2): of the current points, or (``initial``) of
+        """Each body's mass centre (m), (bodies, dim): of the current points, or (``initial``) of
         their start positions."""
         x = self.point_arrays()["x0" if initial else "x"]
         body, m = self.scene.body, self._mass
         n_b = len(self._body_radius)
         return (
             np.stack(
-                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(2)], axis=1
+                [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(x.shape[1])],
+                axis=1,
             )
             / np.bincount(body, weights=m, minlength=n_b)[:, None]
         )

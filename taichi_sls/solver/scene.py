@@ -104,7 +104,36 @@ def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
         else:
             inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
         owner[(owner == -1) & inside] = bi
+    if case.contact.initial == "fillet":
+        _sphere_bridges(case, P, owner)
     return owner
+
+
+def _sphere_bridges(case: Case, P: np.ndarray, owner: np.ndarray) -> None:
+    """``contact.initial = "fillet"`` in 3D: every pair of spheres joined by the 2D fillet's
+    bridge turned about their line of centres, the region a torus of tube radius rho cuts off
+    (the closing of their union by a ball of radius rho, exact for a pair), each free point
+    given to the sphere whose outline is nearer."""
+    rho = case.contact.fillet_radius_um
+    spheres = [
+        (i, np.asarray(b.center_um, float), b.radius_um)
+        for i, b in enumerate(case.bodies)
+        if b.shape == "disc" and not b.perturbation
+    ]
+    for k, (ia, ca, ra) in enumerate(spheres):
+        for ib, cb, rb in spheres[k + 1 :]:
+            d = float(np.linalg.norm(cb - ca))
+            f = fillet((0.0, 0.0), ra, (d, 0.0), rb, rho)  # in a plane through the axis
+            if f is None:
+                continue
+            free = np.nonzero(owner == -1)[0]
+            rel = P[free] - ca
+            s = rel @ ((cb - ca) / d)  # along the axis, and the distance from it
+            r = np.sqrt(np.maximum((rel**2).sum(axis=1) - s * s, 0.0))
+            sel = in_bridge(f, (0.0, 0.0), (d, 0.0), s, r)
+            da = np.linalg.norm(P[free] - ca, axis=1) - ra
+            db = np.linalg.norm(P[free] - cb, axis=1) - rb
+            owner[free[sel]] = np.where(da[sel] <= db[sel], ia, ib)
 
 
 def _owners(case: Case, px: np.ndarray, py: np.ndarray, spacing: float) -> np.ndarray:
@@ -166,8 +195,9 @@ def _seed(
 
 
 def laplace_pressure(case: Case, body) -> float:
-    """Initial in-plane pressure of a body (Pa): gamma/R for a disc (Young-Laplace in 2D) with
-    ``surface_tension.initial_stress = "laplace"`` and surface tension on, else 0. A powder
+    """Initial pressure of a body (Pa): gamma/R for a disc (Young-Laplace in 2D), 2 gamma/R for
+    a sphere (3D), with ``surface_tension.initial_stress = "laplace"`` and surface tension on,
+    else 0. A powder
     particle at the preheat temperature has long been in equilibrium with its surface tension;
     started stress-free, the soft discs are compressed by it at t = 0, which opens the neck
     (docs/model.md: the nolaser case)."""
@@ -178,7 +208,9 @@ def laplace_pressure(case: Case, body) -> float:
         or body.shape != "disc"
     ):
         return 0.0
-    return case.materials[body.material].surface_tension_N_m / (body.radius_um * 1e-6)
+    # a sphere's two principal curvatures: 2 gamma / R (3D); a cylinder's one: gamma / R (2D)
+    curvatures = 2.0 if case.domain.dim == 3 else 1.0
+    return curvatures * case.materials[body.material].surface_tension_N_m / (body.radius_um * 1e-6)
 
 
 def build_scene(case: Case) -> Scene:

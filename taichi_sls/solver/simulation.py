@@ -26,6 +26,7 @@ from .monitor import point_monitors
 from .necks import NeckMeasures
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
+from .section3d import equivalent_radii
 from .step import advance, init_box
 from .step_config import Layout, choose_layout, step_config
 from .time_step import (
@@ -161,13 +162,11 @@ class Simulation(NeckMeasures):
             T_floor_K=coldest + KELVIN if case.physics.thermal else -math.inf,
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
-        two_d = case.domain.dim == 2  # neck sections are 2D (issue #39): 3D reports them NaN
-        self._pair = len(case.bodies) >= 2 and two_d
-        # the contacts, found once on the seeded points; each body's neck reach sqrt(area / pi)
+        self._pair = len(case.bodies) >= 2
+        # the contacts, found once on the seeded points; each body's equivalent radius (reach)
         sc = self.scene
-        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell) if two_d else []
-        area = np.bincount(sc.body, weights=sc.vol)
-        self._body_radius = np.sqrt(area / np.pi)
+        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell)
+        self._body_radius = equivalent_radii(sc.body, sc.vol, case.domain.dim)
         self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
         self._e_static: float | None = None  # the step-independent part of energy_bound
 
