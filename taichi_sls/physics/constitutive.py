@@ -15,6 +15,7 @@ import math
 
 from taichi_sls.backend import ti
 
+from . import small_matrix
 from .codes import Strain, StressForm, StressReading
 from .materials import lerp_phase, viscosity
 from .small_matrix import IDENTITY, ZERO_MATRIX, ZERO_VECTOR, conjugate, matmul, matmul_bt
@@ -160,10 +161,9 @@ def bulk_shear(mp: ti.template(), xi):
 
 @ti.func
 def principal_frame(b, dim: ti.template()):
-    """Eigenvalues (a 3-vector) and eigenvectors (columns of a rotation Q) of the symmetric 3x3
-    b. Plane strain (dim 2): the in-plane 2x2 block in closed form, angle from atan2 (exact for
-    near-equal eigenvalues; ti.svd's 2x2 treats an off-diagonal below 1e-5 as zero, which erased
-    small elastic shears step after step) and b_zz as the third; dim 3: ti.sym_eig."""
+    """Eigenvalues and eigenvectors (columns of a rotation Q) of the symmetric 3x3 b. Plane
+    strain: the 2x2 block in closed form by atan2 (exact for near-equal eigenvalues; ti.svd's
+    zeroed off-diagonals below 1e-5, erasing small shears) and b_zz; 3D: symmetric_eigen."""
     Q = ti.Matrix(IDENTITY[3])
     ev = ti.Vector([b[0, 0], b[1, 1], b[2, 2]])
     if ti.static(dim == 2):
@@ -175,7 +175,7 @@ def principal_frame(b, dim: ti.template()):
         Q[0, 0], Q[0, 1], Q[1, 0], Q[1, 1] = c, -s, s, c
         ev[0], ev[1] = mean + r, mean - r
     else:
-        ev, Q = ti.sym_eig(b)
+        ev, Q = small_matrix.symmetric_eigen(b)
     return ev, Q
 
 
