@@ -132,16 +132,24 @@ class OutputWriter:
             return
         if self.png:
             self._painter.draw(t_s, x, fields)
-            path = self.out_dir / "frames" / f"frame_{index:04d}.png"
-            self._painter.save(path, self.dpi)
-            self._png_paths[index] = path
+            self._save_png(index)
         if self.vtu:
-            extra = point_data
-            if extra is None:
-                extra = {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
-            vtu = {"T_C": fields["T_C"], "liquid_fraction": fields["liquid_fraction"], **extra}
-            self._vtu.write(index, float(t_s), x, vtu)
+            read = {k: fields[k] for k in ("T_C", "liquid_fraction")}
+            self._vtu.write(index, float(t_s), x, {**read, **self._vtu_extra(fields, point_data)})
         self.frames_written += 1
+
+    def _save_png(self, index: int) -> None:
+        path = self.out_dir / "frames" / f"frame_{index:04d}.png"
+        self._painter.save(path, self.dpi)
+        self._png_paths[index] = path
+
+    def _vtu_extra(
+        self, fields: dict[str, np.ndarray], point_data: Mapping[str, np.ndarray] | None
+    ) -> Mapping[str, np.ndarray]:
+        """The point arrays beside T and the liquid fraction: the caller's, or the deformation."""
+        if point_data is not None:
+            return point_data
+        return {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
 
     def _frame_3d(
         self,
@@ -160,14 +168,9 @@ class OutputWriter:
         if self.png:
             assert isinstance(self._painter, Frame3DPainter)
             self._painter.draw(t_s, grid, surf, fields["T_C"])
-            path = self.out_dir / "frames" / f"frame_{index:04d}.png"
-            self._painter.save(path, self.dpi)
-            self._png_paths[index] = path
+            self._save_png(index)
         if self.vtu:
-            extra = point_data
-            if extra is None:
-                extra = {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
-            self._vtu.write(index, t_s, x, {**read, **extra})
+            self._vtu.write(index, t_s, x, {**read, **self._vtu_extra(fields, point_data)})
             self._vtu.write_surface(index, t_s, surf.verts, surf.tris, surf.values)
 
     # ----------------------------------------------------------------- end of run
