@@ -8,7 +8,8 @@
                      neck (the melted-pair study), refinement (the paper's cases under grid and
                      dt refinement), packing3d (the 3D bed generator's packing fraction),
                      process (a PA12 layer's density against energy density and bed
-                     temperature, and its sensitivities)
+                     temperature, and its sensitivities), symmetry (a 3D pair's quarter under
+                     two mirror walls against the full domain), speed3d (explicit 3D throughput)
     robustness       the stress matrix of cases at the edge of stability
     case             print the case-file reference (docs/case_reference.md)
 
@@ -141,6 +142,7 @@ def parser() -> argparse.ArgumentParser:
         bed3d_packing,
         compile_bench,
         cost_error,
+        implicit3d_bench,
         implicit_bench,
         neck_study,
         pair_window,
@@ -149,7 +151,9 @@ def parser() -> argparse.ArgumentParser:
         robustness,
         sinter_hold,
         speed,
+        speed3d,
         sphere_pair,
+        symmetry,
     )
     from .studies.process import study as process_study
     from .studies.sweep import runner as sweep
@@ -164,8 +168,8 @@ def parser() -> argparse.ArgumentParser:
     sweep.add_parser(sub)
     bench = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, compile, cost, implicit, hold, window, accuracy, "
-        "paper, neck, refinement, packing3d, process, spherepair",
+        help="benchmarks and studies: speed, compile, cost, implicit, implicit3d, hold, window, "
+        "accuracy, paper, neck, refinement, packing3d, process, symmetry, speed3d, spherepair",
     )
     studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
     for module in (
@@ -173,6 +177,7 @@ def parser() -> argparse.ArgumentParser:
         compile_bench,
         cost_error,
         implicit_bench,
+        implicit3d_bench,
         sinter_hold,
         pair_window,
         accuracy,
@@ -181,6 +186,8 @@ def parser() -> argparse.ArgumentParser:
         refinement,
         bed3d_packing,
         process_study,
+        symmetry,
+        speed3d,
         sphere_pair,
     ):
         module.add_parser(studies)

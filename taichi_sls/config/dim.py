@@ -124,11 +124,6 @@ def _refuse_in_3d(case: Any) -> None:
             f"bed.previous_layer = {case.bed.previous_layer!r} with domain.dim = 3: layer files "
             f"are {not_yet}; allowed in 3D: a generated bed or bed.csv of spheres"
         )
-    if case.time.integrator != "explicit":
-        raise CaseError(
-            f"time.integrator = {case.time.integrator!r} with domain.dim = 3: the implicit "
-            f'system is {not_yet}; allowed in 3D: "explicit"'
-        )
     if case.thermal.top_surface != "insulated":
         raise CaseError(
             f"thermal.top_surface = {case.thermal.top_surface!r} with domain.dim = 3: the loss "
@@ -139,11 +134,3 @@ def _refuse_in_3d(case: Any) -> None:
             f'solver.layout = "blocks" with domain.dim = 3: the race-free colouring is 4 '
             f'colours of 2D blocks, {not_yet}; allowed in 3D: "auto", "serial", "parallel"'
         )
-    out = case.output
-    for key in ("png", "gif", "vtu"):
-        if key in out.model_fields_set and getattr(out, key):
-            raise CaseError(
-                f"output.{key} = true with domain.dim = 3: frames are {not_yet}; "
-                "allowed in 3D: false (the time series and summary are written)"
-            )
-        setattr(out, key, False)  # the 2D defaults (png, gif on) do not apply

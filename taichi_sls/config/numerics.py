@@ -154,8 +154,13 @@ class Time(Model):
         "preconditioned by pyamg's smoothed aggregation) or auto (direct up to "
         "direct_max_unknowns grid velocity components, amg above)",
     )
-    direct_max_unknowns: int = Field(
-        200_000, ge=1, description='implicit, linear_solver = "auto": the largest direct solve'
+    direct_max_unknowns: int | None = Field(
+        None,
+        ge=1,
+        description='implicit, linear_solver = "auto": the largest direct solve, in unknowns; '
+        "unset: 200000 in 2D, 40000 in 3D (a 3D row holds up to 375 entries, not 75: the "
+        "Cholesky factor fills faster, and AMG-CG solves as fast near 35k unknowns; "
+        "docs/implicit.md)",
     )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
         "auto",

@@ -38,6 +38,7 @@ from .sections import (
     Thermal,
 )
 from .surface import SurfaceTension
+from .symmetry import check_symmetry, within_mirrors
 
 MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
 
@@ -185,6 +186,7 @@ class Case(Model):
     def _cross_checks(self) -> Case:
         """What a field type alone cannot express."""
         check_dimension(self)
+        check_symmetry(self)
         check_overlaps(self.bodies, self.contact.allow_overlap)  # the case's own, before the bed
         self._expand_bed()
         if not self.bodies:
@@ -245,6 +247,7 @@ class Case(Model):
                     "least 3 (or a vertices_file)"
                 )
             lo, hi = b.centres_extent() if b.shape == "points" else b.extent()
+            lo, hi = within_mirrors(self, b, lo, hi)
             if any(a < -eps or c > s + eps for a, c, s in zip(lo, hi, sides, strict=False)):
                 span = ", ".join(f"{n} {a}..{c}" for n, a, c in zip("xyz", lo, hi, strict=False))
                 raise CaseError(

@@ -64,8 +64,10 @@ class Domain(Model):
 
 
 class Wall(Model):
-    mechanical: Literal["slip", "stick", "open"] = Field(
-        "slip", description="slip: zero normal velocity"
+    mechanical: Literal["slip", "stick", "open", "mirror"] = Field(
+        "slip",
+        description="slip: zero normal velocity; mirror: a plane of symmetry (slip, insulated, "
+        "no surface at the plane; the case is the half of a symmetric scene)",
     )
     thermal: Literal["insulated", "fixed"] = Field("insulated", description="heat flux condition")
     temperature_C: float = Field(140.0, description="wall temperature when thermal = fixed")

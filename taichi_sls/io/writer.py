@@ -13,9 +13,11 @@ import numpy as np
 
 from .atomic import atomic_write_text
 from .frames import DEFORM_LABELS, FramePainter
+from .frames3d import Frame3DPainter, View3D
 from .gif import write_gif
 from .series import BED_PANELS, BED_PANELS_PER_ROW, MONITORED, SeriesWriter, plot_series
 from .summary import write_summary
+from .surface3d import colour_grid, surface
 from .vtu import VtuWriter
 
 # the drawn deformation in a VTU written without the full point data: named for what it is
@@ -40,6 +42,7 @@ class OutputWriter:
         dpi: int = 80,
         deformation: str = "displacement",
         bed: bool = False,
+        view3d: View3D | None = None,
     ) -> None:
         if deformation not in DEFORM_LABELS:
             raise ValueError(
@@ -58,9 +61,15 @@ class OutputWriter:
         (self.out_dir / "frames").mkdir(exist_ok=True)
         self._png_paths: dict[int, Path] = {}
         self.series = SeriesWriter(self.out_dir / "timeseries.csv")
-        self._painter = FramePainter(
-            (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi, bed=bed
-        )
+        self.view3d = view3d  # a 3D run: points (N, 3), frames of io/frames3d.py
+        self._painter: FramePainter | Frame3DPainter
+        if view3d is None:
+            self._painter = FramePainter(
+                (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi, bed=bed
+            )
+        else:
+            self._painter = Frame3DPainter((xmin, xmax, ymin, ymax), view3d, float(melt_C), bed)
+        self.domain_um = (xmin, xmax, ymin, ymax)
         self._vtu = VtuWriter(self.out_dir)
 
     # ----------------------------------------------------------------- simple files
@@ -83,6 +92,7 @@ class OutputWriter:
     def resume(self) -> None:
         """Continue an existing output folder: keep its time series rows and frames."""
         self.series.resume()
+        self._vtu.resume()
         for p in sorted((self.out_dir / "frames").glob("frame_*.png")):
             self._png_paths[int(p.stem.split("_")[1])] = p
 
@@ -103,10 +113,10 @@ class OutputWriter:
         ``deform`` is the drawn deformation (``deformation``); ``point_data`` the VTU's further
         fields (:func:`taichi_sls.io.vtu.point_data`). Without it the VTU carries ``deform``
         under the name of what it is."""
-        if not (self.png or self.vtu):  # nothing to draw (a 3D run: frames not built yet)
+        if not (self.png or self.vtu):  # nothing to draw
             self.frames_written += 1
             return
-        x = np.asarray(x_um, dtype=float).reshape(-1, 2)
+        x = np.asarray(x_um, dtype=float).reshape(-1, 2 if self.view3d is None else 3)
         fields = {
             "T_C": np.asarray(T_C, dtype=float).ravel(),
             "deform": np.asarray(deform, dtype=float).ravel(),
@@ -116,6 +126,10 @@ class OutputWriter:
             if v.shape != (len(x),):
                 raise ValueError(f"frame {index}: {name} has {v.size} values for {len(x)} points")
         index = int(index)
+        if self.view3d is not None:
+            self._frame_3d(index, float(t_s), x, fields, point_data)
+            self.frames_written += 1
+            return
         if self.png:
             self._painter.draw(t_s, x, fields)
             path = self.out_dir / "frames" / f"frame_{index:04d}.png"
@@ -128,6 +142,33 @@ class OutputWriter:
             vtu = {"T_C": fields["T_C"], "liquid_fraction": fields["liquid_fraction"], **extra}
             self._vtu.write(index, float(t_s), x, vtu)
         self.frames_written += 1
+
+    def _frame_3d(
+        self,
+        index: int,
+        t_s: float,
+        x: np.ndarray,
+        fields: dict[str, np.ndarray],
+        point_data: Mapping[str, np.ndarray] | None,
+    ) -> None:
+        """A 3D frame: the colour grid and its surface once, for the PNG and the VTU."""
+        v = self.view3d
+        xmin, xmax, ymin, ymax = self.domain_um
+        read = {k: fields[k] for k in ("T_C", "liquid_fraction")}
+        grid = colour_grid(x, read, v.point_spacing_um, ((xmin, xmax), (ymin, ymax), v.z_range_um))
+        surf = surface(grid)
+        if self.png:
+            assert isinstance(self._painter, Frame3DPainter)
+            self._painter.draw(t_s, grid, surf, fields["T_C"])
+            path = self.out_dir / "frames" / f"frame_{index:04d}.png"
+            self._painter.save(path, self.dpi)
+            self._png_paths[index] = path
+        if self.vtu:
+            extra = point_data
+            if extra is None:
+                extra = {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
+            self._vtu.write(index, t_s, x, {**read, **extra})
+            self._vtu.write_surface(index, t_s, surf.verts, surf.tris, surf.values)
 
     # ----------------------------------------------------------------- end of run
 

@@ -28,6 +28,7 @@ from ..config.layer_file import CARRIED_STATE, OPTIONAL_STATE
 from ..io.bed_outcome_plot import plot_bed_outcome
 from ..io.contacts_plot import plot_contacts
 from ..io.contacts_table import read_contacts, write_contacts
+from ..io.frames3d import section_layer, view_3d
 from ..io.layer_output import write_layer
 from ..io.outcome_plot import plot_outcome
 from ..io.vtu import point_data
@@ -67,6 +68,7 @@ def _writer(case: Case, out_dir: Path) -> OutputWriter:
         dpi=o.dpi,
         deformation=o.deformation,
         bed=is_bed(case),
+        view3d=view_3d(case) if case.domain.dim == 3 else None,
     )
 
 
@@ -316,9 +318,10 @@ def run_case(
         writer.summary(summary)
         writer.finish(beam_off(case) if bed is not None else None)
         try:
-            # a bed's outcome.png is drawn with its contacts above; a 3D run's is not built
-            if bed is None and case.domain.dim == 2:
-                plot_outcome(out_dir, sc.x, sim.point_arrays()["x"], sc.body)
+            # a bed's outcome.png is drawn with its contacts above; a 3D run's from one layer
+            if bed is None and (case.domain.dim == 2 or len(case.bodies) <= 2):
+                x_end = sim.point_arrays()["x"]
+                plot_outcome(out_dir, *section_layer(case, sc.x, x_end, sc.body))
         except Exception as e:  # noqa: BLE001 -- a plot must never cost the run's outputs
             print(f"warning: outcome.png not drawn ({type(e).__name__}: {e})", file=sys.stderr)
     return summary

@@ -24,6 +24,7 @@ class WallMechanical(IntEnum):
     SLIP = 0  # zero normal velocity
     STICK = 1  # zero velocity
     OPEN = 2  # no condition
+    MIRROR = 3  # a plane of symmetry: zero normal velocity, ghosts mirrored (physics/mirror.py)
 
 
 class ViscosityModel(IntEnum):

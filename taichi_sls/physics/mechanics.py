@@ -90,11 +90,17 @@ def apply_walls(cfg: ti.template(), I, v):
                 v[d] = 0.0
             elif ti.static(kind_lo == WallMechanical.STICK):
                 v = ti.Vector(ZERO_VECTOR[cfg.dim])
+            elif ti.static(kind_lo == WallMechanical.MIRROR):
+                if I[d] == lo:  # the ghosts beyond hold the mirror image (physics/mirror.py)
+                    v[d] = 0.0
         if I[d] >= hi[d]:
             if ti.static(kind_hi == WallMechanical.SLIP):
                 v[d] = 0.0
             elif ti.static(kind_hi == WallMechanical.STICK):
                 v = ti.Vector(ZERO_VECTOR[cfg.dim])
+            elif ti.static(kind_hi == WallMechanical.MIRROR):
+                if I[d] == hi[d]:  # the ghosts beyond hold the mirror image (physics/mirror.py)
+                    v[d] = 0.0
     return v
 
 

@@ -17,12 +17,12 @@ K^cap is the semi-implicit capillary stiffness of Baensch (2001) and Hysing (200
 surface-energy outline, the surface Laplacian gamma sum_q w_q L_q (t . grad N_i)(t . grad N_j) 1
 over the Gauss points of its segments (physics/surface_energy.py): the force at x^n + dt v to
 first order, which lifts the capillary step limit. In 3D the same on the triangles of the
-marching-tetrahedra surface, (P grad N_i) . (P grad N_j) with P = I - n n^T (the implicit
-integrators themselves are 2D only so far: config/dim.py).
+marching-tetrahedra surface, (P grad N_i) . (P grad N_j) with P = I - n n^T.
 
 A point couples the nodes of its 3^dim stencil, so node i's row holds the 5^dim nodes within two
 of it: the matrix lives on the grid as ``K[I, I_j - I_i + 2, a, b]`` and solver/implicit.py
-gathers it into a sparse matrix.
+gathers it into a sparse matrix. The fixed part (inertia, capillary stiffness) is a scalar times
+the identity in the components and lives as scalar rows ``K[I, I_j - I_i + 2]``.
 """
 
 from taichi_sls.backend import ti
@@ -95,15 +95,15 @@ def scatter_point_conductance(cfg: ti.template(), K: ti.template(), base, w, dw,
 
 @ti.func
 def scatter_mass(cfg: ti.template(), K: ti.template(), I, m_over_dt):
-    """The inertia m_i / dt on node i's diagonal."""
-    for a in ti.static(range(cfg.dim)):
-        K[I, ti.Vector([REACH] * cfg.dim), a, a] += m_over_dt
+    """The inertia m_i / dt on node i's diagonal (K: scalar rows, times the identity)."""
+    K[I, ti.Vector([REACH] * cfg.dim)] += m_over_dt
 
 
 @ti.func
 def segment_tangent(cfg: ti.template(), K: ti.template(), a, b, scale):
-    """K_ij += scale w_q L (t . grad N_i)(t . grad N_j) 1 over the Gauss points of segment a-b
-    (the surface Laplacian of the outline; scale = dt gamma)."""
+    """K_ij += scale w_q L (t . grad N_i)(t . grad N_j) over the Gauss points of segment a-b
+    (the surface Laplacian of the outline; scale = dt gamma; K: scalar rows, times the
+    identity)."""
     d = b - a
     L = d.norm()
     if L > 0.0:
@@ -117,15 +117,14 @@ def segment_tangent(cfg: ti.template(), K: ti.template(), a, b, scale):
                 oi = stencil_offset(i, cfg.dim)
                 for j in range(3**cfg.dim):
                     k = scale * wq[g] * L * tg[i] * tg[j]
-                    off = stencil_offset(j, cfg.dim) - oi + REACH
-                    for c in ti.static(range(cfg.dim)):
-                        K[base + oi, off, c, c] += k
+                    K[base + oi, stencil_offset(j, cfg.dim) - oi + REACH] += k
 
 
 @ti.func
 def triangle_tangent(cfg: ti.template(), K: ti.template(), a, b, c, scale):
-    """K_ij += scale w_q A (P grad N_i) . (P grad N_j) 1, P = I - n n^T, over the three points of
-    triangle abc (physics/surface_energy.py, triangle_force): the surface Laplacian in 3D."""
+    """K_ij += scale w_q A (P grad N_i) . (P grad N_j), P = I - n n^T, over the three points of
+    triangle abc (physics/surface_energy.py, triangle_force): the surface Laplacian in 3D
+    (scalar rows, as segment_tangent)."""
     nrm = (b - a).cross(c - a)
     A2 = nrm.norm()
     if A2 > 0.0:
@@ -144,9 +143,7 @@ def triangle_tangent(cfg: ti.template(), K: ti.template(), a, b, c, scale):
                     for e in ti.static(range(cfg.dim)):
                         gg += Gs[i, e] * Gs[j, e]
                     if gg != 0.0:
-                        off = stencil_offset(j, cfg.dim) - oi + REACH
-                        for e in ti.static(range(cfg.dim)):
-                            K[base + oi, off, e, e] += kq * gg
+                        K[base + oi, stencil_offset(j, cfg.dim) - oi + REACH] += kq * gg
 
 
 @ti.func

@@ -45,7 +45,7 @@ from .contour import cell_segments
 from .grid import active, ramped_gamma, scatter_add
 from .shape import STENCIL_SHAPE, node_weight, stencil
 from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
-from .tetra import tet_corner, tet_triangles
+from .tetra import cell_tet_corner, tet_triangles
 
 C_INTERFACE = 0.5  # the outline is the c = 1/2 contour
 # a node's neighbourhood, offsets -1..1 per axis, by dimension
@@ -327,7 +327,7 @@ def outline_triangles(
                     f = ti.Vector([0.0, 0.0, 0.0, 0.0])
                     p = ti.Matrix(ZERO_MATRIX[4, 3])
                     for k in range(4):
-                        o = tet_corner(t, k)
+                        o = cell_tet_corner(I, t, k)
                         f[k] = C_INTERFACE - nd.colour[I + o]
                         for d in range(3):
                             p[k, d] = x0[d] + cfg.h * o[d]

@@ -7,6 +7,13 @@ axes in the order of the t-th permutation). Translated cubes share their faces' 
 the surface is closed across cells, and a field linear on each tetrahedron has one sheet per
 tetrahedron: no ambiguous case to resolve (marching squares' saddle). A tetrahedron with one or
 three corners inside gives one triangle, with two a quadrilateral cut into two triangles.
+
+Kuhn's triangulation is not symmetric under a reflection: the cube with an odd index along an
+axis is therefore cut as its mirror image in that axis (:func:`cell_tet_corner`). Two cubes
+that share a face still cut it along one diagonal (the reflection in x leaves the diagonal of an
+x face as it was), and the surface of a field symmetric about a node plane is then symmetric
+too: the cube i and its mirror image 2 P - 1 - i have opposite parities. A mirror wall
+(physics/mirror.py) needs it, and a symmetric scene keeps its symmetry.
 """
 
 from taichi_sls.backend import ti
@@ -29,6 +36,17 @@ def tet_corner(t, k):
         o[b] = 1
     if k >= 3:
         o[c] = 1
+    return o
+
+
+@ti.func
+def cell_tet_corner(I, t, k):
+    """As :func:`tet_corner` in the cube of lower corner I: reflected along each axis where
+    I is odd."""
+    o = tet_corner(t, k)
+    for d in ti.static(range(3)):
+        if I[d] % 2 == 1:
+            o[d] = 1 - o[d]
     return o
 
 

@@ -154,13 +154,15 @@ class ImplicitFields:
     """The implicit step's grid data (solver/implicit.py, physics/stiffness.py): the fixed part
     of its matrix (inertia, capillary stiffness) and the points' tangent, both as node i's row
     over the WIDTH^dim nodes around it; the internal force; which velocity components are free
-    (1) and their unknown's index (-1: none)."""
+    (1) and their unknown's index (-1: none). The fixed part is a scalar times the identity in
+    the components (one value per neighbour, not dim x dim: 1 kB of a node's 10 in 3D, where
+    the full rows took 18)."""
 
     def __init__(self, cfg: StepConfig) -> None:
-        grid = (cfg.nx, cfg.ny)
-        rows = grid + (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim)
-        self.fixed = ti.field(float, rows)
-        self.tangent = ti.field(float, rows)
+        grid = tuple(cfg.shape)
+        row = grid + (WIDTH,) * cfg.dim
+        self.fixed = ti.field(float, row)
+        self.tangent = ti.field(float, row + (cfg.dim, cfg.dim))
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
         # which nodes are unknowns and their numbers, one struct: the host reads the kinds and
@@ -170,7 +172,7 @@ class ImplicitFields:
             "dof": ti.types.vector(cfg.dim, ti.i32),
         }
         if cfg.heat_implicit:  # backward-Euler heat (solver/implicit_heat.py)
-            self.conductance = ti.field(float, grid + (WIDTH,) * cfg.dim)
+            self.conductance = ti.field(float, row)
             numbering["heat_node"] = ti.i32  # physics.codes.HeatNode
             numbering["heat_dof"] = ti.i32  # a free node's unknown (-1: none)
         self.numbering = ti.types.struct(**numbering).field(shape=grid, layout=ti.Layout.SOA)

@@ -98,8 +98,11 @@ class StepReport:
 def _clear_matrix(K: ti.template(), I, dim: ti.template()):
     for r in range(WIDTH**dim):
         o = stencil_offset(r, dim, WIDTH)
-        for a, b in ti.static(ti.ndrange(dim, dim)):
-            K[I, o, a, b] = 0.0
+        if ti.static(len(K.shape) == 2 * dim):  # scalar rows (the fixed part)
+            K[I, o] = 0.0
+        else:
+            for a, b in ti.static(ti.ndrange(dim, dim)):
+                K[I, o, a, b] = 0.0
 
 
 def begin(st: State) -> None:
@@ -311,6 +314,8 @@ class ImplicitStepper:
         how = linear_solver(self.case, sys_.n)
         if self.linear is None or self.linear.how != how:
             self.linear = LinearSolver(how, LINEAR_RTOL)
+        if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
+            self.linear.near_null = sys_.rigid_body_modes()
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
         if self.penalty > 0.0:  # the light nodes' near-null modes (module docstring)

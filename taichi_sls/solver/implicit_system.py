@@ -71,7 +71,8 @@ def gather(
                     value = 0.0
                     if c >= 0:
                         if part == Part.FIXED:
-                            value = st.implicit.fixed[I, o, a, b]
+                            if a == b:  # a scalar times the identity (ImplicitFields)
+                                value = st.implicit.fixed[I, o]
                         else:
                             value = st.implicit.tangent[I, o, a, b]
                     vals[k, slot] = value
@@ -153,6 +154,20 @@ class GridSystem:
         values = np.zeros(len(self.indices))
         np.add.at(values, where, np.concatenate(vals))
         return values
+
+    def rigid_body_modes(self) -> np.ndarray:
+        """The grid velocities of rigid motions at the unknowns, one column each: dim
+        translations and dim (dim - 1) / 2 rotations about the unknowns' centre, in cells (the
+        near-null modes of the elastic tangent, for smoothed aggregation)."""
+        dim = self.dof_node.shape[1] - 1
+        x = self.dof_node[:, :dim].astype(float)
+        x -= x.mean(axis=0)
+        comp = self.dof_node[:, dim]
+        modes = [(comp == a).astype(float) for a in range(dim)]
+        for a, b in ((0, 1), (1, 2), (2, 0))[: 1 if dim == 2 else 3]:
+            # rotation in the a-b plane: u_a = -x_b, u_b = x_a
+            modes.append(np.where(comp == a, -x[:, b], 0.0) + np.where(comp == b, x[:, a], 0.0))
+        return np.stack(modes, axis=1)
 
     def add_to_fixed(self, values: np.ndarray) -> None:
         """Add values on the stored entries to the fixed part (before any residual)."""

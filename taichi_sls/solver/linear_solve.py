@@ -15,7 +15,9 @@ are few, and scipy's wrapper cost as much per call as two of them.
   the symbolic one while the pattern is unchanged), or where a matrix is not positive definite
   qdldl's LDL^T with AMD ordering: exact for the matrix it was built from.
 - ``amg``: pyamg's smoothed-aggregation hierarchy as the preconditioner (memory and time linear
-  in the unknowns, for the large systems where a factorization's fill grows too big).
+  in the unknowns, for the large systems where a factorization's fill grows too big); given
+  ``near_null`` (the implicit step gives the rigid-body modes of its grid velocities, 3 in 2D
+  and 6 in 3D), its aggregates interpolate those exactly, as elasticity wants.
 """
 
 from collections.abc import Callable
@@ -34,11 +36,21 @@ class LinearSolveError(RuntimeError):
     with a fresh preconditioner did not converge."""
 
 
+# time.direct_max_unknowns unset: the largest direct solve by dimension (docs/implicit.md)
+DIRECT_MAX_UNKNOWNS = {2: 200_000, 3: 40_000}
+
+
+def direct_max_unknowns(case: Case) -> int:
+    """``time.direct_max_unknowns``, or where unset the dimension's DIRECT_MAX_UNKNOWNS."""
+    limit = case.time.direct_max_unknowns
+    return DIRECT_MAX_UNKNOWNS[case.domain.dim] if limit is None else limit
+
+
 def linear_solver(case: Case, n: int) -> str:
     """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
     choice = case.time.linear_solver
     if choice == "auto":
-        choice = "direct" if n <= case.time.direct_max_unknowns else "amg"
+        choice = "direct" if n <= direct_max_unknowns(case) else "amg"
     return choice
 
 
@@ -66,6 +78,9 @@ class LinearSolver:
         self._factor = None
         self._factored: sp.csr_matrix | None = None  # the matrix the factorization is of
         self._precondition: Callable[[np.ndarray], np.ndarray] | None = None
+        # amg: the matrix's near-null modes (columns), which smoothed aggregation keeps exact
+        # on its coarse levels; None: the constant vector (pyamg's default)
+        self.near_null: np.ndarray | None = None
 
     def solve(self, A: sp.csr_matrix, b: np.ndarray, refresh: bool = False) -> np.ndarray:
         """x with |A x - b| <= rtol |b|; ``refresh``: factorize A afresh (direct: solve with it;
@@ -74,21 +89,24 @@ class LinearSolver:
         if A is self._factored and self.how == "direct":
             return self._factor.solve(b)
         same = self._same_pattern(A)
-        if refresh or not same:
+        fresh = refresh or not same
+        if fresh:
             self._factorize(A, new_pattern=not same)
             if self.how == "direct":
                 return self._factor.solve(b)
-        x, converged = self._cg(A, b, self.refresh_after)
-        if not converged:
+        # a fresh hierarchy is not set up again: CG runs on to its limit with it (the same
+        # iterates as a second set-up from the same matrix, at half the cost)
+        x, converged = self._cg(A, b, CG_MAX_ITERATIONS if fresh else self.refresh_after)
+        if not converged and not fresh:
             self._factorize(A, new_pattern=False)
             if self.how == "direct":
                 return self._factor.solve(b)
             x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
-            if not converged:
-                raise LinearSolveError(
-                    f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
-                    f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
-                )
+        if not converged:
+            raise LinearSolveError(
+                f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
+                f"the relative residual {self.rtol:g} in {CG_MAX_ITERATIONS} iterations"
+            )
         return x
 
     def _same_pattern(self, A: sp.csr_matrix) -> bool:
@@ -112,7 +130,9 @@ class LinearSolver:
         else:
             import pyamg
 
-            ml = pyamg.smoothed_aggregation_solver(A, symmetry="symmetric", max_coarse=500)
+            ml = pyamg.smoothed_aggregation_solver(
+                A, B=self.near_null, symmetry="symmetric", max_coarse=500
+            )
             self._factor = ml
             self._precondition = ml.aspreconditioner(cycle="V").matvec
         self._pattern = (A.indptr.copy(), A.indices.copy())

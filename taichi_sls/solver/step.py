@@ -2,6 +2,7 @@
 
     clear_grid     over the active region (grown at the end of G2P to hold every point)
     p2g            mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; eq. 21**
+    (fold_after_p2g, and fold_before_update before grid_update: mirror walls, physics/mirror.py)
     grid_temperature  node temperature (fixed-temperature walls)*
     surface_force  level set and curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
     heat_flux      grad T_p, conduction and laser heat rates (eqs. 29-31)*
@@ -42,6 +43,7 @@ from ..physics.mechanics import (
     p2g_mechanics,
     p2g_momentum,
 )
+from ..physics.mirror import fold_after_p2g, fold_before_update
 from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.surface_energy import scatter_volume, surface_energy_force
 from ..physics.thermal import (
@@ -349,9 +351,11 @@ def advance_clock(st: ti.template(), heat: ti.template(), geom: ti.template()):
 STAGES = (
     clear_grid,
     p2g,
+    fold_after_p2g,
     grid_temperature_stage,
     surface_force,
     heat_flux,
+    fold_before_update,
     grid_update,
     g2p,
     advance_clock,

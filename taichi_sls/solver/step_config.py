@@ -144,16 +144,18 @@ def threads(case: Case) -> int:
 
 
 def choose_layout(case: Case, n_points: int) -> Layout:
-    """``solver.layout``; "auto": parallel on a GPU; on a CPU the blocks layout for large
-    scenes when there is more than one thread, else the serial one."""
+    """``solver.layout``; "auto": parallel on a GPU; on a CPU the blocks layout for large 2D
+    scenes when there is more than one thread, else the serial one (3D on a CPU: serial, as the
+    parallel layout's atomic scatters cost 2.6x its CPU time and were slower in wall time too;
+    docs/speed.md, ``taichi-sls bench speed3d``)."""
     lay = case.solver.layout
     if lay != "auto":
         return Layout[lay.upper()]
     if case.solver.arch == "gpu":
         return Layout.PARALLEL
-    if n_points >= BLOCKS_FROM_POINTS and threads(case) > 1:
+    if n_points >= BLOCKS_FROM_POINTS and threads(case) > 1 and case.domain.dim == 2:
         # the blocks' 4-colour scatter is 2D (config/dim.py refuses it by name in 3D)
-        return Layout.BLOCKS if case.domain.dim == 2 else Layout.PARALLEL
+        return Layout.BLOCKS
     return Layout.SERIAL
 
 

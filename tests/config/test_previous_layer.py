@@ -147,3 +147,24 @@ def test_bundled_second_layer_and_its_resolved_case_loads_back(tmp_path):
     path.write_text(case_to_toml(case))
     again = load_case(path)
     assert [b.model_dump() for b in again.bodies] == [b.model_dump() for b in case.bodies]
+
+
+def test_bundled_machine_second_layer_restarts_molten():
+    """cases/machine_layer2.toml: machine_layer's layer at the end of its layer time, carried
+    with its solid fraction (the 172 C melt has not crystallised), under a new layer of discs
+    that reaches above it; the layer file's points restart partly molten."""
+    import numpy as np
+
+    from taichi_sls.config.layer_file import read_layer
+    from taichi_sls.config.loading import bundled_root
+
+    case = load_case(bundled_case("machine_layer2"))
+    shapes = [b.shape for b in case.bodies]
+    n_below = shapes.count("points")
+    assert n_below > 0 and shapes.count("disc") >= 20
+    below_top = max(b.extent()[1][1] for b in case.bodies[:n_below])
+    new_top = max(b.extent()[1][1] for b in case.bodies[n_below:])
+    assert new_top > below_top + 20.0
+    layer = read_layer(bundled_root() / "layers" / "machine_layer.npz")
+    solid = np.asarray(layer.state["solid_fraction"])
+    assert 0.2 < np.mean(solid < 0.5) < 0.9  # a part of the layer is still melt

@@ -1,6 +1,6 @@
 """A 3D bed runs: cases/bed3d_cooling.toml (20 deposited spheres), shortened, from the command
-line. Its outputs are the time series and summary; the per-contact bed outputs, which read 2D
-neck sections, are not made, and the outcome says so."""
+line. Its outputs are the time series, summary, frames and GIF; the per-contact bed outputs,
+which read 2D neck sections, are not made, and the outcome says so."""
 
 import json
 import os
@@ -26,3 +26,5 @@ def test_bundled_3d_bed_runs_from_the_command_line(tmp_path):
     assert s["outcome"]["fused"] is None and "in 3D" in s["outcome"]["no_verdict"]
     assert s["bed_generator"]["spheres"] == 20 and s["bed_generator"]["contacts"] == 35
     assert not (out / "contacts.csv").exists() and (out / "timeseries.csv").is_file()
+    assert len(list((out / "frames").glob("frame_*.png"))) == 2  # the start and 1 frame
+    assert (out / "animation.gif").is_file()

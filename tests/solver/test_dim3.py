@@ -175,8 +175,8 @@ def test_slip_wall_in_z_stops_the_sphere_and_keeps_its_slide():
 
 @pytest.mark.slow
 def test_bundled_3d_case_runs_from_the_command_line(tmp_path):
-    """cases/sphere3d_heat.toml, shortened: the summary and time series of a 3D run (energies
-    in J), no frames; the sphere cools through the plate, and no point rises above the 200 C
+    """cases/sphere3d_heat.toml, shortened: the summary, time series, frames and GIF of a 3D
+    run (energies in J); the sphere cools through the plate, and no point rises above the 200 C
     it was seeded at (with the sub-grid filter's rate per the 3D thermal limit, its core rose
     to 200.15 C by 20 us)."""
     out = tmp_path / "run"
@@ -191,4 +191,5 @@ def test_bundled_3d_case_runs_from_the_command_line(tmp_path):
     assert s["final"]["T_min_C"] < 160.0 < s["initial"]["T_min_C"]  # the plate cools its foot
     assert s["T_peak_C"] < 200.0 + 1e-9  # measured 200.0 exactly
     assert s["final"]["contact_line_um"] is None  # NaN (JSON null): neck sections are 2D only
-    assert (out / "timeseries.csv").is_file() and not list((out / "frames").glob("*.png"))
+    assert (out / "timeseries.csv").is_file() and (out / "animation.gif").is_file()
+    assert len(list((out / "frames").glob("frame_*.png"))) == 3  # frames 0, 1, 2

@@ -1,0 +1,148 @@
+"""The implicit step in 3D, its cost against the unknowns: ``taichi-sls bench implicit3d
+[--quick] [--steps N] [--out renders]``.
+
+Two molten PA12 spheres, R = 20 um, touching at a point in a 120 x 60 x 60 um box (surface
+tension on, no gravity), implicit steps at the "auto" step, at h = 4, 3 and 2.5 um (``--quick``:
+4 only), each with the direct solver (CHOLMOD) and with AMG-CG (pyamg's smoothed aggregation
+with the rigid-body modes). After one step (which compiles), ``--steps`` steps are timed: the
+wall time per step and per Newton linear solve, Newton iterations, CG iterations per solve
+(0: the factorization alone), the unknowns, and the
+implicit grid rows' memory per grid node, per active node (one with unknowns) and per point.
+Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/implicit.md, "In
+3D")."""
+
+import argparse
+import csv
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..config import case_from_dict
+from ..solver import linear_solve
+from ..solver.simulation import Simulation
+
+SPACINGS_UM = (4.0, 3.0, 2.5)
+COLUMNS = [
+    "h_um",
+    "solver",
+    "points",
+    "unknowns",
+    "steps",
+    "dt_s",
+    "wall_per_step_s",
+    "wall_per_solve_s",
+    "newton_iterations_per_step",
+    "cg_iterations_per_solve",
+    "bytes_per_node",
+    "bytes_per_active_node",
+    "bytes_per_point",
+]
+
+
+def pair_case(h_um: float, solver: str) -> dict:
+    """The sphere pair at spacing h_um with time.linear_solver = solver."""
+    spheres = [
+        {"center_um": [x, 30.0, 30.0], "radius_um": 20.0, "temperature_C": 200.0}
+        for x in (40.0, 80.0)
+    ]
+    return {
+        "grid": {"spacing_um": h_um},
+        "domain": {"dim": 3, "width_um": 120.0, "height_um": 60.0, "depth_um": 60.0},
+        "bodies": spheres,
+        "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0, 0.0]},
+        "time": {"integrator": "implicit", "linear_solver": solver, "end_s": 1.0},
+        "output": {"frames": 1},
+    }
+
+
+def _grid_bytes(sim: Simulation) -> int:
+    """The implicit step's grid fields (rows, force, numbering), in bytes."""
+    imp = sim.state.implicit
+    total = 0
+    for f in (imp.fixed, imp.tangent):
+        total += 8 * int(np.prod(f.shape))
+    dim = sim.state.cfg.dim
+    nodes = int(np.prod(imp.fixed.shape[:dim]))
+    return total + nodes * dim * (8 + 4 + 4)  # internal force, free, dof
+
+
+def measure(h_um: float, solver: str, steps: int) -> dict:
+    sim = Simulation(case_from_dict(pair_case(h_um, solver)))
+    sim.advance(1)  # compiles the step's kernels
+    spent = {"s": 0.0, "n": 0}
+    solve = linear_solve.LinearSolver.solve
+
+    def timed(self, A, b, refresh=False):
+        t0 = time.perf_counter()
+        try:
+            return solve(self, A, b, refresh)
+        finally:
+            spent["s"] += time.perf_counter() - t0
+            spent["n"] += 1
+
+    linear_solve.LinearSolver.solve = timed
+    try:
+        newton0 = sim.implicit.newton_total
+        cg0 = sim.implicit.linear.stats.cg_iterations
+        t0 = time.perf_counter()
+        sim.advance(steps)
+        wall = time.perf_counter() - t0
+    finally:
+        linear_solve.LinearSolver.solve = solve
+    dim = sim.state.cfg.dim
+    grid = _grid_bytes(sim)
+    nodes = int(np.prod(sim.state.implicit.fixed.shape[:dim]))
+    unknowns = sim.implicit.last.unknowns
+    active = int((sim.state.implicit.free.to_numpy().reshape(-1, dim).max(axis=1) > 0).sum())
+    return {
+        "h_um": h_um,
+        "solver": sim.implicit.last.solver,
+        "points": sim.scene.n_points,
+        "unknowns": unknowns,
+        "steps": steps,
+        "dt_s": float(sim.state.scalars.dt[None]),
+        "wall_per_step_s": round(wall / steps, 3),
+        "wall_per_solve_s": round(spent["s"] / max(spent["n"], 1), 4),
+        "newton_iterations_per_step": round((sim.implicit.newton_total - newton0) / steps, 2),
+        "cg_iterations_per_solve": round(
+            (sim.implicit.linear.stats.cg_iterations - cg0) / max(spent["n"], 1), 1
+        ),
+        "bytes_per_node": round(grid / nodes),
+        "bytes_per_active_node": round(grid / max(active, 1)),
+        "bytes_per_point": round(grid / sim.scene.n_points),
+    }
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    ap = sub.add_parser("implicit3d", help="the 3D implicit step's cost against its unknowns")
+    ap.add_argument("--out", default="renders", help="folder for implicit3d.csv and .json")
+    ap.add_argument("--quick", action="store_true", help="h = 4 um only")
+    ap.add_argument("--steps", type=int, default=3, help="timed steps per row")
+    ap.set_defaults(func=main)
+
+
+def main(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for h in SPACINGS_UM[:1] if args.quick else SPACINGS_UM:
+        for solver in ("direct", "amg"):
+            rows.append(measure(h, solver, args.steps))
+            r = rows[-1]
+            print(
+                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['unknowns']:7d} unknowns "
+                f"{r['wall_per_step_s']:7.2f} s/step {r['wall_per_solve_s']:7.3f} s/solve "
+                f"{r['newton_iterations_per_step']:5.2f} Newton/step "
+                f"{r['cg_iterations_per_solve']:5.1f} CG/solve  "
+                f"{r['bytes_per_node']} B/node {r['bytes_per_active_node']} B/active node "
+                f"{r['bytes_per_point']} B/point",
+                flush=True,
+            )
+    with (out / "implicit3d.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    (out / "implicit3d.json").write_text(json.dumps(rows, indent=1))
+    return 0
