@@ -275,12 +275,13 @@ def run_case(
                 rows = bed.rows(sim)
                 write_contacts(out_dir / "contacts.csv", rows)
                 summary["bed"] = bed_summary(sim, rows, bed.density_initial)
-                plot_contacts(out_dir, rows, arrays["x"] * 1e6)
+                xy_um = arrays["x"][:, :2] * 1e6  # 3D: projected onto x-y (a view along z)
+                plot_contacts(out_dir, rows, xy_um)
                 density = summary["bed"]["relative_density"]
                 plot_bed_outcome(
                     out_dir,
                     rows,
-                    arrays["x"] * 1e6,
+                    xy_um,
                     time_molten=arrays["time_molten"],
                     density=(density["initial"], density["final"]),
                     neck_growth=case.fusion.neck_growth,
