@@ -210,8 +210,6 @@ def test_3d_bed_refusals_name_their_keys(tmp_path):
     layer.write_bytes(b"")
     msg = _error({"previous_layer": str(layer), "count": 3})
     assert msg.startswith("bed.previous_layer =") and "domain.dim = 3" in msg
-    fillet = _error({"count": 3, "x_range_um": [0, 80]}, contact={"initial": "fillet"})
-    assert fillet.startswith('contact.initial = "fillet" with domain.dim = 3')
     msg = _error(
         {"count": 900, "median_diameter_um": 20.0, "x_range_um": [0, 60]},
         domain={"dim": 3, "width_um": 60.0, "height_um": 40.0, "depth_um": 60.0},
