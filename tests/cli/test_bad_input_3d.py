@@ -51,7 +51,6 @@ BAD = [
         'bodies[0].shape = "polygon"',
     ),
     ("csf", sphere('[surface_tension]\nmethod = "csf"', tension="true"), "surface_tension.method"),
-    ("fillet_2d_only", sphere('[contact]\ninitial = "fillet"'), 'contact.initial = "fillet"'),
     ("area_seeding_2d_only", sphere('[grid]\nseeding = "area"'), 'grid.seeding = "area"'),
     (
         "sphere_outside",
