@@ -1,7 +1,7 @@
 """``contacts.csv``: one row per contact of a bed run (jobs/bed_outcome.py), rewritten
 atomically at every output frame so that it is always valid and a resumed run can continue it.
 Lengths in um, times in s; melted_through, refrozen and fused are 0 or 1; an empty neck_melt_um
-is a contact that never melted."""
+is a contact that never melted. A 3D bed's rows carry z_um after y_um."""
 
 from __future__ import annotations
 
@@ -35,10 +35,11 @@ def write_contacts(path: Path, rows: list[dict[str, Any]]) -> None:
     """Write the rows (dicts with every column of COLUMNS) as CSV; NaN as an empty cell."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS)
+    columns = COLUMNS if not rows or "z_um" not in rows[0] else (*COLUMNS[:4], "z_um", *COLUMNS[4:])
+    w.writerow(columns)
     for r in rows:
         cells = []
-        for c in COLUMNS:
+        for c in columns:
             v = r[c]
             finite = not isinstance(v, float) or math.isfinite(v)
             cells.append(fmt_cell(v) if finite else "")

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..solver.contacts import bilinear
+from ..solver.section3d import trilinear
 
 SAMPLES_PER_CELL = 4  # sampling of the colour for the areas: a quarter cell each way
 
@@ -54,12 +55,51 @@ def relative_density(
     }
 
 
-def melt_extent(
-    x0: np.ndarray, time_molten: np.ndarray, top_m: float, spacing_m: float
+def relative_density_3d(
+    colour: np.ndarray,
+    h: float,
+    off: int,
+    x_range_m: tuple[float, float],
+    z_range_m: tuple[float, float],
+    height_m: float,
 ) -> dict[str, float]:
-    """Depth below ``top_m``, lowest height and x-extent (m) of the points ever fully molten,
-    by their start positions x0 (m), each with its square of side ``spacing_m``; depth and
-    width 0 (bottom NaN) when none melted."""
+    """:func:`relative_density` of a 3D layer over x_range_m x z_range_m (m): the material's
+    volume over the volume under the top surface, and the surface's mean height (m)."""
+    d = h / SAMPLES_PER_CELL
+    (x0, x1), (z0, z1) = x_range_m, z_range_m
+    nx, nz = max(1, round((x1 - x0) / d)), max(1, round((z1 - z0) / d))
+    xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+    zs = z0 + (np.arange(nz) + 0.5) * (z1 - z0) / nz
+    ys = (np.arange(max(1, round(height_m / d))) + 0.5) * d
+    Y, Z = np.meshgrid(ys, zs, indexing="ij")
+    rows = np.arange(len(ys))[:, None]
+    columns, material = 0, 0
+    for x in xs:  # one x-slice at a time: (y, z) samples
+        p = np.stack([np.full_like(Y, x), Y, Z], axis=-1)
+        solid = trilinear(colour, h, off, p, outside=0.0) >= 0.5
+        columns += int(np.sum(np.max(np.where(solid, rows, -1), axis=0) + 1))
+        material += int(np.count_nonzero(solid))
+    cell = d * ((x1 - x0) / nx) * ((z1 - z0) / nz)
+    envelope = columns * cell
+    return {
+        "relative_density": material * cell / envelope if envelope > 0 else float("nan"),
+        "envelope_volume_m3": envelope,
+        "material_volume_m3": material * cell,
+        "mean_top_m": envelope / ((x1 - x0) * (z1 - z0)),
+    }
+
+
+def melt_extent(
+    x0: np.ndarray,
+    time_molten: np.ndarray,
+    top_m: float,
+    spacing_m: float,
+    across_axis: int = 0,
+) -> dict[str, float]:
+    """Depth below ``top_m``, lowest height and width (m) of the points ever fully molten, by
+    their start positions x0 (m), each with its square (cube) of side ``spacing_m``; the width
+    is their extent along ``across_axis`` (x in 2D; 3D: the bed axis across the scan); depth
+    and width 0 (bottom NaN) when none melted."""
     molten = time_molten > 0.0
     if not molten.any():
         return {
@@ -73,6 +113,6 @@ def melt_extent(
     return {
         "melt_depth_m": float(top_m - bottom),
         "melt_bottom_m": bottom,
-        "track_width_m": float(x[:, 0].max() - x[:, 0].min() + spacing_m),
+        "track_width_m": float(x[:, across_axis].max() - x[:, across_axis].min() + spacing_m),
         "molten_points": int(molten.sum()),
     }

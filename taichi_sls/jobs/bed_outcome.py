@@ -23,6 +23,15 @@ Per contact (a, b) of ``Simulation.contacts``:
   bed are the fillet's, which do not depend on h. The adhesive growth a soft solid makes without
   heat is therefore counted as growth; the same bed run without laser heat (absorptivity 0)
   measures it per contact.
+
+In 3D (``domain.dim = 3``) the same record: the contact point on the line of the sphere centres
+where the radical plane crosses it, the neck region the points within the slab of half-width
+``fusion.neck_region_cells`` cells about that plane and within the smaller radius of the line of
+centres, the necks read by the 3D section (solver/section3d.py: the diameter 2 sqrt(A / pi) of
+the narrowest c = 1/2 section normal to the line of centres), the relative density under the
+layer's top surface over the bed area and the track's width across the scan
+(jobs/bed_layer.py). The contacts and outcome plots draw the points and contacts projected onto
+the x-y plane (a view along z).
 """
 
 from __future__ import annotations
@@ -35,16 +44,15 @@ import numpy as np
 
 from ..config import Case
 from ..solver.simulation import Simulation
-from .bed_layer import melt_extent, relative_density
+from .bed_layer import melt_extent, relative_density, relative_density_3d
 from .outcome import laser_acted
 
 NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
 
 
 def is_bed(case: Case) -> bool:
-    """A case whose outcome is read per contact: more than two bodies, in 2D (the necks and
-    the layer's density read 2D sections of the colour; a 3D bed reports neither yet)."""
-    return len(case.bodies) > 2 and case.domain.dim == 2
+    """A case whose outcome is read per contact: more than two bodies (2D or 3D)."""
+    return len(case.bodies) > 2
 
 
 def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
@@ -58,7 +66,8 @@ def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
         s = (d * d + radius[a] ** 2 - radius[b] ** 2) / (2.0 * d)  # radical line from a
         points.append(centre[a] + s * e)
         normals.append(e)
-    return np.reshape(points, (-1, 2)), np.reshape(normals, (-1, 2))
+    dim = centre.shape[1]
+    return np.reshape(points, (-1, dim)), np.reshape(normals, (-1, dim))
 
 
 def neck_regions(sim: Simulation, points: np.ndarray, normals: np.ndarray) -> list[np.ndarray]:
@@ -70,7 +79,10 @@ def neck_regions(sim: Simulation, points: np.ndarray, normals: np.ndarray) -> li
     for (a, b), p, e in zip(sim.contacts, points, normals, strict=True):
         rel = x0 - p
         along = np.abs(rel @ e)
-        across = np.abs(rel[:, 0] * e[1] - rel[:, 1] * e[0])
+        if len(e) == 2:
+            across = np.abs(rel[:, 0] * e[1] - rel[:, 1] * e[0])
+        else:  # the distance from the line of centres
+            across = np.linalg.norm(rel - np.outer(rel @ e, e), axis=1)
         reach = min(sim.body_radii_m[a], sim.body_radii_m[b])
         out.append((along <= half) & (across <= reach) & ((body == a) | (body == b)))
     return out
@@ -134,6 +146,7 @@ class ContactHistory:
                     "body_b": b,
                     "x_um": p[0] * 1e6,
                     "y_um": p[1] * 1e6,
+                    **({"z_um": p[2] * 1e6} if len(p) == 3 else {}),
                     "neck_initial_um": self.initial[k],
                     "neck_melt_um": self.melt[k],
                     "melt_end_s": self.melt_s[k],
@@ -151,6 +164,8 @@ def layer_density(sim: Simulation) -> dict[str, float]:
     """The layer's relative density now (jobs/bed_layer.py) between the bed's side walls."""
     cfg = sim.state.cfg
     rep = sim.case.bed_report()
+    if cfg.dim == 3:
+        return _layer_density_3d(sim, rep)
     if rep is not None:
         lo, hi = (v * 1e-6 for v in rep["x_range_um"])
     else:  # bodies listed one by one: the x-extent of the points as seeded
@@ -160,6 +175,29 @@ def layer_density(sim: Simulation) -> dict[str, float]:
     return relative_density(
         sim.raw_colour(), cfg.h, cfg.off, (lo, hi), sim.case.domain.height_um * 1e-6
     )
+
+
+def _layer_density_3d(sim: Simulation, rep: dict | None) -> dict[str, float]:
+    """layer_density in 3D: over the bed's x and z ranges (the points' extents as seeded
+    without a generated bed)."""
+    cfg = sim.state.cfg
+    if rep is not None:
+        ranges = [tuple(v * 1e-6 for v in rep[k]) for k in ("x_range_um", "z_range_um")]
+    else:
+        x0 = sim.scene.x
+        half = 0.5 * cfg.h / sim.case.grid.points_per_cell
+        ranges = [(float(x0[:, k].min()) - half, float(x0[:, k].max()) + half) for k in (0, 2)]
+    return relative_density_3d(
+        sim.raw_colour(), cfg.h, cfg.off, ranges[0], ranges[1], sim.case.domain.height_um * 1e-6
+    )
+
+
+def track_across_axis(case: Case) -> int:
+    """The axis the melt track's width is read along: x in 2D; in 3D the bed axis across the
+    first laser's scan (z for a track along x, x for one along z)."""
+    if case.domain.dim == 2 or not case.lasers:
+        return 0
+    return 2 if case.lasers[0].direction == "x" else 0
 
 
 # the bed's columns of the time series (one value per output frame), in the order plotted
@@ -215,7 +253,11 @@ def bed_summary(
     after = layer_density(sim)
     pt = sim.point_arrays(("x0", "time_molten"))
     spacing = sim.state.cfg.h / sim.case.grid.points_per_cell
-    melt = melt_extent(pt["x0"], pt["time_molten"], sim.case.top_um() * 1e-6, spacing)
+    top = sim.case.top_um() * 1e-6
+    if sim.case.domain.dim == 2:
+        melt = melt_extent(pt["x0"], pt["time_molten"], top, spacing)
+    else:
+        melt = melt_extent(pt["x0"], pt["time_molten"], top, spacing, track_across_axis(sim.case))
     rep = sim.case.bed_report() or {}
     record = {
         "contacts": n,

@@ -263,12 +263,7 @@ def run_case(
             solidified=solid and summary["status"] == "complete",
             baseline_um=baseline_um,
         )
-        if bed is None and len(case.bodies) > 2:  # 3D: the per-contact outputs are 2D only
-            summary["outcome"].update(
-                fused=None,
-                no_verdict=f"{len(case.bodies)} bodies in 3D: the per-contact verdict reads neck "
-                "sections, not built in 3D yet (issue #39)",
-            )
+        if bed is not None and case.domain.dim == 3:  # the 3D generator's own report
             summary["bed_generator"] = case.bed_report()
         if bed is not None:
             summary["outcome"].update(
@@ -280,17 +275,19 @@ def run_case(
                 rows = bed.rows(sim)
                 write_contacts(out_dir / "contacts.csv", rows)
                 summary["bed"] = bed_summary(sim, rows, bed.density_initial)
-                plot_contacts(out_dir, rows, arrays["x"] * 1e6)
+                xy_um = arrays["x"][:, :2] * 1e6  # 3D: projected onto x-y (a view along z)
+                plot_contacts(out_dir, rows, xy_um)
                 density = summary["bed"]["relative_density"]
                 plot_bed_outcome(
                     out_dir,
                     rows,
-                    arrays["x"] * 1e6,
+                    xy_um,
                     time_molten=arrays["time_molten"],
                     density=(density["initial"], density["final"]),
                     neck_growth=case.fusion.neck_growth,
                 )
-                if summary["status"] != "failed":  # the layer a next one is deposited on
+                # the layer a next one is deposited on (layer files are 2D)
+                if summary["status"] != "failed" and case.domain.dim == 2:
                     write_layer_file(out_dir / LAYER_FILE, sim, summary["status"])
                     summary["layer_file"] = LAYER_FILE
             except Exception as e:  # noqa: BLE001 -- never cost the run's other outputs

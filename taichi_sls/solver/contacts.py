@@ -196,11 +196,12 @@ def _gimp_1d(xi: np.ndarray, h: float, lp: float) -> np.ndarray:
 
 
 def point_colour(
-    x: np.ndarray, weight: np.ndarray, h: float, lp: float, off: int, shape: tuple[int, int]
+    x: np.ndarray, weight: np.ndarray, h: float, lp: float, off: int, shape: tuple[int, ...]
 ) -> np.ndarray:
     """sum_p weight_p N_i(x_p) on the nodes (array index i at x = (i - off) h): the P2G of the
-    step (3x3 uGIMP stencil, clamped as solver/step.py clamps it) for a subset of the points.
-    With weight = m_p / (rho V_cell) it is the raw mass colour of those points alone."""
+    step (3x3 uGIMP stencil, 3x3x3 in 3D, clamped as solver/step.py clamps it) for a subset of
+    the points. With weight = m_p / (rho V_cell) it is the raw mass colour of those points
+    alone."""
     out = np.zeros(shape)
     f = x / h
     base = np.floor(f + 0.5).astype(int) - 1
@@ -208,7 +209,12 @@ def point_colour(
     idx = np.clip(base + off, 1, np.array(shape) - 4)
     for a in range(3):
         for b in range(3):
-            np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b), weight * w[a][:, 0] * w[b][:, 1])
+            wab = weight * w[a][:, 0] * w[b][:, 1]
+            if len(shape) == 2:
+                np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b), wab)
+                continue
+            for c in range(3):  # 3D: the third axis of the stencil
+                np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b, idx[:, 2] + c), wab * w[c][:, 2])
     return out
 
 

@@ -157,7 +157,7 @@ class NeckMeasures:
         order = np.argsort(body, kind="stable")
         bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
         members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
-        shape = (cfg.nx, cfg.ny)
+        shape = (cfg.nx, cfg.ny) if cfg.dim == 2 else (cfg.nx, cfg.ny, cfg.nz)
 
         def colour(a: int, b: int) -> np.ndarray:
             sel = np.concatenate([members[a], members[b]])
