@@ -17,7 +17,7 @@ from pydantic import Field, PrivateAttr, model_validator
 from .bed import Bed, bed_discs
 from .bed3d import expand_bed_3d
 from .bodies import Body, Disc, LayerBody
-from .dim import check_dimension
+from .dim import check_dimension, default_laser_depths, unset_laser_depths
 from .errors import CaseError
 from .layer_file import read_layer
 from .materials import Material
@@ -185,10 +185,12 @@ class Case(Model):
     @model_validator(mode="after")
     def _cross_checks(self) -> Case:
         """What a field type alone cannot express."""
+        unset_depths = unset_laser_depths(self)
         check_dimension(self)
         check_symmetry(self)
         check_overlaps(self.bodies, self.contact.allow_overlap)  # the case's own, before the bed
         self._expand_bed()
+        default_laser_depths(self, unset_depths)
         if not self.bodies:
             raise CaseError(f"bodies = []: {NO_BODIES}")
         sides = self.domain_um()

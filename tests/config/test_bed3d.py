@@ -219,3 +219,14 @@ def test_3d_bed_refusals_name_their_keys(tmp_path):
     with pytest.raises(CaseError) as err:
         case_from_dict({"bed": {"count": 3, "x_range_um": [0, 100], "z_range_um": [0, 50]}})
     assert str(err.value).startswith("bed.z_range_um = [0.0, 50.0]: 3D only")
+
+
+def test_a_beam_left_at_mid_depth_follows_the_depth_the_bed_fits():
+    """lasers.N.z_start_um unset: the mid-depth of the domain as the bed fitted it (120 um
+    deep here: 60 um), not of the default depth (the width, 80 um) before the bed set it."""
+    case = _case(
+        {"count": 12, "median_diameter_um": 20.0, "x_range_um": [0, 60], "z_range_um": [0, 120]},
+        lasers=[{"speed_m_s": 4.0, "x_start_um": 0.0}],
+    )
+    assert case.domain.depth() == pytest.approx(120.0)
+    assert case.lasers[0].z_start_um == pytest.approx(60.0)
