@@ -19,28 +19,28 @@ import argparse
 import csv
 import math
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from ..config import Case, case_from_dict
-from ..config.loading import add_set_argument, apply_override
+from ..config.loading import add_set_argument, apply_override, bundled_case
 from ..io.atomic import atomic_path
 from ..solver.simulation import Simulation
 
 R_UM = 20.0
-ETA_PAS = 0.6  # eta_N = eta / 2 = 0.3 Pa s (the zero-yield Perzyna liquid is Newtonian)
-FLUID = {
-    "youngs_solid_Pa": 8.7e5,  # mu = 3e5 Pa: Maxwell time eta / 2 mu = 1 us
-    "youngs_liquid_Pa": 8.7e5,
-    "poisson": 0.45,
-    "yield_solid_Pa": 0.0,
-    "yield_liquid_Pa": 0.0,
-    "hardening_solid_Pa": 0.0,
-    "hardening_liquid_Pa": 0.0,
-    "viscosity_model": "constant",
-    "viscosity_Pas": ETA_PAS,
-}
+
+
+def hopper_fluid() -> dict[str, object]:
+    """Hopper's viscous liquid as cases/verification/hopper.toml defines it (mu = 3e5 Pa,
+    eta = 0.6 Pa s: eta_N = 0.3 Pa s, Maxwell time 1 us), its one material table."""
+    with open(bundled_case("verification/hopper"), "rb") as f:
+        return dict(tomllib.load(f)["materials"]["fluid"])
+
+
+FLUID = hopper_fluid()
+ETA_PAS = float(FLUID["viscosity_Pas"])  # the zero-yield Perzyna liquid is Newtonian, eta / 2
 OPEN = {"mechanical": "open", "thermal": "insulated"}
 
 

@@ -8,21 +8,11 @@ from helpers import make_case
 from taichi_sls.config import CaseError
 from taichi_sls.solver.scene import build_scene
 from taichi_sls.solver.simulation import Simulation
+from taichi_sls.studies.sphere_pair import FLUID
 
 PERIODIC = {"front": {"mechanical": "periodic"}, "back": {"mechanical": "periodic"}}
 SIDES = ("left", "right", "bottom", "top")
 OPEN = {w: {"mechanical": "open", "thermal": "insulated"} for w in SIDES}
-FLUID = {
-    "youngs_solid_Pa": 8.7e5,
-    "youngs_liquid_Pa": 8.7e5,
-    "poisson": 0.45,
-    "yield_solid_Pa": 0.0,
-    "yield_liquid_Pa": 0.0,
-    "hardening_solid_Pa": 0.0,
-    "hardening_liquid_Pa": 0.0,
-    "viscosity_model": "constant",
-    "viscosity_Pas": 0.6,
-}
 
 
 def _blocks(z_ranges: list[tuple[float, float]]) -> dict:
