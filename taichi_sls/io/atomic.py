@@ -7,6 +7,7 @@ writers never collide)."""
 from __future__ import annotations
 
 import contextlib
+import csv
 import os
 import secrets
 from collections.abc import Iterator
@@ -41,3 +42,14 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> None:
     """UTF-8 text version of :func:`atomic_write_bytes`."""
     atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def write_rows(
+    path: str | os.PathLike[str], rows: list[dict], columns: list[str] | None = None
+) -> None:
+    """``rows`` as a CSV at ``path`` (columns: the first row's keys, or ``columns``), written
+    whole or not at all."""
+    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns or list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)

@@ -12,7 +12,6 @@ Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/imp
 3D")."""
 
 import argparse
-import csv
 import json
 import time
 from pathlib import Path
@@ -20,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import case_from_dict
+from ..io.atomic import atomic_write_text, write_rows
 from ..solver import linear_solve
 from ..solver.simulation import Simulation
 
@@ -140,9 +140,6 @@ def main(args: argparse.Namespace) -> int:
                 f"{r['bytes_per_point']} B/point",
                 flush=True,
             )
-    with (out / "implicit3d.csv").open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=COLUMNS)
-        w.writeheader()
-        w.writerows(rows)
-    (out / "implicit3d.json").write_text(json.dumps(rows, indent=1))
+    write_rows(out / "implicit3d.csv", rows, COLUMNS)
+    atomic_write_text(out / "implicit3d.json", json.dumps(rows, indent=1))
     return 0

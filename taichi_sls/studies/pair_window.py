@@ -21,7 +21,8 @@ import numpy as np
 
 from ..config import load_case
 from ..config.loading import add_set_argument
-from .sinter_hold import compare, print_against_hopper, run_or_reuse, write_rows
+from ..io.atomic import write_rows
+from .sinter_hold import compare, print_against_hopper, run_or_reuse
 
 CASE = "pair_window"
 ALIGN_S = 1e-3  # the pulse is over and the pair molten through by then

@@ -14,7 +14,6 @@ prediction at 0.1, 0.3 and 1 s.
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 from pathlib import Path
@@ -23,7 +22,7 @@ import numpy as np
 
 from ..config import Material, load_case
 from ..config.loading import add_set_argument
-from ..io.atomic import atomic_path
+from ..io.atomic import write_rows
 from ..io.series import read_series
 from ..jobs.case_run import complete_summary, run_case
 from ..physics.materials import KELVIN
@@ -143,14 +142,6 @@ def run_or_reuse(case: str, overrides: list[str], runs: str) -> tuple[Path, dict
     if summary is None:
         summary = run_case(load_case(case, overrides), run_dir)
     return run_dir, summary
-
-
-def write_rows(path: Path, rows: list[dict]) -> None:
-    """``rows`` as a CSV at ``path``, written whole or not at all."""
-    with atomic_path(path) as tmp, tmp.open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
 
 
 def print_against_hopper(rows: list[dict], key: str, at: tuple[float, ...], label: str) -> None:

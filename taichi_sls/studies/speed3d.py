@@ -14,7 +14,6 @@ parallel layout alone runs (the serial one is a CPU layout). Writes speed3d.csv 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import time
@@ -23,6 +22,7 @@ from pathlib import Path
 from taichi_sls.backend import ti
 
 from ..config import Case, case_from_dict
+from ..io.atomic import atomic_write_text, write_rows
 from ..solver.step import advance
 from .speed import build, field_bytes, peak_rss_mb
 
@@ -139,10 +139,7 @@ def main(args: argparse.Namespace) -> int:
     rows: list[dict] = []
     for n in (int(s) for s in args.sizes.split(",") if s):
         rows.extend(measure(n, args.arch, args.seconds))
-    with open(out / "speed3d.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    (out / "speed3d.json").write_text(json.dumps(rows, indent=1) + "\n")
+    write_rows(out / "speed3d.csv", rows)
+    atomic_write_text(out / "speed3d.json", json.dumps(rows, indent=1) + "\n")
     print(f"wrote {out / 'speed3d.csv'}, {out / 'speed3d.json'}")
     return 0

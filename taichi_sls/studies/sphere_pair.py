@@ -16,7 +16,6 @@ work; R/h = 4 is a quick look).
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 import tomllib
@@ -26,7 +25,7 @@ import numpy as np
 
 from ..config import Case, case_from_dict
 from ..config.loading import add_set_argument, apply_override, bundled_case
-from ..io.atomic import atomic_path
+from ..io.atomic import write_rows
 from ..solver.simulation import Simulation
 
 R_UM = 20.0
@@ -117,10 +116,7 @@ def main(args: argparse.Namespace) -> int:
     rows = coalesce(case, args.frames)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    with atomic_path(out / "sphere_pair.csv") as tmp, open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "sphere_pair.csv", rows)
     last = rows[-1]
     print(
         f"sphere pair, R/h = {args.r_over_h:g}: x/R {last['x_over_R']:.3f} at tau "

@@ -15,7 +15,6 @@ symmetry.json (the worst differences against ``TOLERANCE``); exits 1 beyond it.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 import time
@@ -25,6 +24,7 @@ import numpy as np
 
 from ..config import Case
 from ..config.loading import case_from_dict
+from ..io.atomic import atomic_write_text, write_rows
 
 RADIUS_UM = 16.0
 POWER_W = 0.3  # the beam melts the pair's contact within the run
@@ -157,11 +157,8 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     result = compare(args.cells_per_radius)
     rows, summary = result["rows"], result["summary"]
-    with open(out / "symmetry.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    (out / "symmetry.json").write_text(json.dumps(summary, indent=2) + "\n")
+    write_rows(out / "symmetry.csv", rows)
+    atomic_write_text(out / "symmetry.json", json.dumps(summary, indent=2) + "\n")
     print(
         f"symmetry at R/h = {summary['cells_per_radius']}: quarter {summary['points_quarter']} "
         f"points ({summary['stepping_s_quarter']:.1f} s), full {summary['points_full']} "
