@@ -2,6 +2,10 @@
 optimisation (about 10x faster to compile; the tests measure accuracy, not speed)."""
 
 import functools
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 from taichi_sls.config import case_from_dict, deep_update
 
@@ -90,3 +94,16 @@ def explicit_coarse_peak_C() -> float:
     ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
     ref.advance(round(1e-4 / ref.dt))
     return ref.monitors()["T_peak_C"]
+
+
+def run_command(module: list[str], case_path, out) -> subprocess.CompletedProcess:
+    """``python -m <module> <case> --out <out>`` as a user starts it, this checkout on the path;
+    its stdout and stderr as text."""
+    root = Path(__file__).resolve().parents[1]
+    return subprocess.run(
+        [sys.executable, "-m", *module, str(case_path), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(root)},
+        timeout=120,
+    )

@@ -1,12 +1,10 @@
 """The command lines themselves, as a user starts them: a bad case file ends with one line and
 exit status 2, never a traceback."""
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers import run_command
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -23,14 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_python_m_bad_file_one_line(tmp_path, module, content, says):
     p = tmp_path / "bad.toml"
     p.write_bytes(content)
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    r = subprocess.run(
-        [sys.executable, "-m", *module, str(p), "--out", str(tmp_path / "o")],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    r = run_command(module, p, tmp_path / "o")
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2, r.stderr
     assert len(lines) == 1 and lines[0].startswith(f"error: {p}: ") and says in lines[0]

@@ -4,16 +4,10 @@ traceback. What config/dim.py and config/symmetry.py refuse is checked in depth 
 tests/config/test_dim.py and tests/physics/test_mirror.py; here the user's path through the
 command line."""
 
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
+from helpers import run_command
 
 from taichi_sls.cli import main
-
-ROOT = Path(__file__).resolve().parents[2]
 
 SPHERE_3D = """
 [domain]
@@ -119,14 +113,7 @@ def test_a_bad_3d_input_ends_with_one_line(tmp_path, capsys, text, says):
 def test_the_command_itself_exits_2_on_a_sphere_outside_the_domain(tmp_path):
     p = tmp_path / "bad.toml"
     p.write_text(sphere(body="center_um = [20.0, 20.0, 28.0]\nradius_um = 10.0"))
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    r = subprocess.run(
-        [sys.executable, "-m", "taichi_sls", "run", str(p), "--out", str(tmp_path / "o")],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    r = run_command(["taichi_sls", "run"], p, tmp_path / "o")
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2, r.stderr
     assert len(lines) == 1 and "bodies[0]: extent" in lines[0] and "z 18.0..38.0" in lines[0]
