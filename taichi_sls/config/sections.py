@@ -48,9 +48,9 @@ class Domain(Model):
         2,
         description="2: a plane section, every extensive output per unit depth (energies in "
         "J/m, the _J_per_m columns); 3: a box width x height x depth, the same outputs in J "
-        "(the column names keep _J_per_m); y is up in both. 3D (issue #39) runs the explicit "
-        "mechanics and heat of spheres ([[bodies]] discs with [x, y, z] centres) and boxes; "
-        "what it lacks is refused by its key (docs/limitations.md)",
+        "(timeseries.csv's columns end in _J); y is up in both. 3D (issue #39) runs spheres "
+        "([[bodies]] discs with [x, y, z] centres), cylinders and boxes; what it lacks is "
+        "refused by its key (docs/limitations.md)",
     )
     width_um: float = Field(80.0, gt=0, description="domain width (um); x from 0")
     height_um: float = Field(48.0, gt=0, description="domain height (um); y from 0 (baseplate)")

@@ -27,6 +27,11 @@ VTU_DEFORM_NAMES = {
 }
 
 
+def per_metre_to_joules(column: str) -> str:
+    """A 2D energy column (``..._J_per_m``, per metre of depth) named for 3D (``..._J``)."""
+    return column.removesuffix("_J_per_m") + "_J" if column.endswith("_J_per_m") else column
+
+
 class OutputWriter:
     """Writes everything a run produces into ``out_dir``; see the module docstring."""
 
@@ -81,7 +86,10 @@ class OutputWriter:
         write_summary(self.out_dir / "summary.json", data)
 
     def row(self, values: dict[str, float]) -> None:
-        """Append a row to timeseries.csv (the whole file rewritten atomically)."""
+        """Append a row to timeseries.csv (the whole file rewritten atomically). In 3D the
+        energies are in J, not per metre of depth: their columns end in ``_J`` there."""
+        if self.view3d is not None:
+            values = {per_metre_to_joules(k): v for k, v in values.items()}
         self.series.row(values)
 
     @property

@@ -151,6 +151,15 @@ STUDIES = (
         case="hopper3d",
         on_request=True,
     ),
+    Study(  # the 3D pair at the resolution, to tau = 2 (about an hour on one core)
+        "hopper3d_r20",
+        (20,),
+        (20,),
+        "neck_tau1",
+        sets={"verification": {"hopper_taus": [0.5, 1.0, 2.0]}},
+        case="hopper3d",
+        on_request=True,
+    ),
 )
 
 

@@ -193,3 +193,6 @@ def test_bundled_3d_case_runs_from_the_command_line(tmp_path):
     assert s["final"]["contact_line_um"] is None  # NaN (JSON null): neck sections are 2D only
     assert (out / "timeseries.csv").is_file() and (out / "animation.gif").is_file()
     assert len(list((out / "frames").glob("frame_*.png"))) == 3  # frames 0, 1, 2
+    header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
+    assert "enthalpy_J" in header and "laser_energy_J" in header  # 3D energies in J
+    assert not [c for c in header if c.endswith("_J_per_m")]
