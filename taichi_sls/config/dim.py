@@ -30,6 +30,11 @@ def check_dimension(case: Any) -> None:
                 f"bed.z_range_um = {case.bed.z_range_um}: 3D only (domain.dim = 2 deposits "
                 "discs over bed.x_range_um)"
             )
+        if case.time.implicit_rows == "blocks":
+            raise CaseError(
+                'time.implicit_rows = "blocks": 3D only (domain.dim = 2 keeps its rows dense '
+                'over the grid; allowed: "auto", "dense")'
+            )
         if case.domain.depth_um is not None:
             raise CaseError(
                 f"domain.depth_um = {case.domain.depth_um}: 3D only (domain.dim = 2 is a plane "

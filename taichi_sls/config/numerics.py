@@ -162,6 +162,14 @@ class Time(Model):
         "Cholesky factor fills faster, and AMG-CG solves as fast near 35k unknowns; "
         "docs/implicit.md)",
     )
+    implicit_rows: Literal["auto", "dense", "blocks"] = Field(
+        "auto",
+        description="implicit, 3D: how the step stores each grid node's matrix rows (10 kB a "
+        "node): dense over the grid (the fastest to assemble), or by blocks of 4 x 4 x 4 nodes "
+        "allocated where the step writes (the nodes near material: a third of the memory for "
+        "a pair in its box, some 20 % more assembly time; docs/implicit.md); auto: blocks "
+        "where the dense rows would pass 1 GiB. 2D: always dense",
+    )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
         "auto",
         description="implicit integrator: the heat in explicit substeps of at most "

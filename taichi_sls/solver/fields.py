@@ -149,6 +149,23 @@ class SurfaceScratch:
         self.resultant = ti.Vector.field(3, float, ())  # force x, y and interface mass
 
 
+ROW_BLOCK = 4  # nodes along each edge of a block of 3D rows (time.implicit_rows = "blocks")
+
+
+def row_field(grid: tuple[int, ...], row: tuple[int, ...], sparse: bool) -> ti.Field:
+    """A field of one row per grid node (``row`` its shape): dense over the grid, or (3D,
+    ``sparse``) a pointer over blocks of ROW_BLOCK^3 nodes, each block allocated when the step
+    first writes into it, so that the rows' memory follows the nodes near material and not the
+    whole grid (issue #39 item 5). An unwritten row reads 0."""
+    if not sparse:
+        return ti.field(float, grid + row)
+    f = ti.field(float)
+    blocks = tuple(-(-n // ROW_BLOCK) for n in grid)
+    nodes = ti.root.pointer(ti.ijk, blocks).dense(ti.ijk, ROW_BLOCK)
+    nodes.dense(ti.axes(*range(len(grid), len(grid) + len(row))), row).place(f)
+    return f
+
+
 @ti.data_oriented
 class ImplicitFields:
     """The implicit step's grid data (solver/implicit.py, physics/stiffness.py): the fixed part
@@ -161,8 +178,11 @@ class ImplicitFields:
     def __init__(self, cfg: StepConfig) -> None:
         grid = tuple(cfg.shape)
         row = grid + (WIDTH,) * cfg.dim
-        self.fixed = ti.field(float, row)
-        self.tangent = ti.field(float, row + (cfg.dim, cfg.dim))
+        # 3D, time.implicit_rows: the rows by blocks of nodes that the step writes
+        # (solver/implicit.py clear_rows empties them)
+        self.sparse_rows = cfg.sparse_rows
+        self.fixed = row_field(grid, (WIDTH,) * cfg.dim, self.sparse_rows)
+        self.tangent = row_field(grid, (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim), self.sparse_rows)
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
         # which nodes are unknowns and their numbers, one struct: the host reads the kinds and

@@ -107,7 +107,31 @@ def _clear_matrix(K: ti.template(), I, dim: ti.template()):
 
 def begin(st: State) -> None:
     """Everything of the step before the Newton loop (module docstring)."""
+    if st.implicit.sparse_rows:
+        clear_rows(st.implicit.fixed)
     in_order(st, _begin)
+
+
+def allocated_row_nodes(K, dim: int) -> int:
+    """How many grid nodes a row field holds storage for: all of them when dense, those of
+    the blocks written so far when sparse (their bytes: this times the row's)."""
+    return int(_count_allocated(K)) // int(np.prod(K.shape[dim:]))
+
+
+@ti.kernel
+def _count_allocated(K: ti.template()) -> ti.i64:
+    n = ti.i64(0)
+    for _ in ti.grouped(K):
+        n += 1
+    return n
+
+
+@ti.kernel
+def clear_rows(K: ti.template()):
+    """Zero the allocated blocks of a sparse row field (solver/fields.py ``row_field``): a
+    struct-for visits only those, where the dense rows are cleared node by node over the box."""
+    for idx in ti.grouped(K):
+        K[idx] = 0.0
 
 
 @ti.func
@@ -117,7 +141,8 @@ def _begin(st: ti.template()):
     nd = ti.static(st.nodes)
     dt = st.scalars.dt[None]
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
+        if ti.static(not st.implicit.sparse_rows):
+            _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
         m = nd.mass[I]
         vn = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         free = ti.Vector.zero(ti.i32, st.cfg.dim)
@@ -177,8 +202,9 @@ def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.
 def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if st.implicit.with_tangent[None]:
-            _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
+        if ti.static(not st.implicit.sparse_rows):
+            if st.implicit.with_tangent[None]:
+                _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
         st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         nd.v[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
     for k in range(v.shape[0]):
@@ -286,6 +312,8 @@ class ImplicitStepper:
         entries."""
         st = self.st
         st.implicit.with_tangent[None] = int(tangent)
+        if tangent and st.implicit.sparse_rows:
+            clear_rows(st.implicit.tangent)
         internal_force(st, v, sys_.dof_node)
         f_int = np.empty(sys_.n)
         cols = np.empty((1, 1), dtype=np.int32)  # not written

@@ -21,6 +21,7 @@ from ..physics.codes import (
     WallMechanical,
 )
 from ..physics.materials import KELVIN
+from ..physics.stiffness import WIDTH as ROW_WIDTH
 from .scene import Scene
 
 
@@ -101,6 +102,7 @@ class StepConfig:
     subgrid_filter: float  # chi of the sub-grid temperature filter (physics/thermal.py)
     subgrid_rate: float  # its rate (1/s): chi = 1 - exp(-rate dt_heat) for a varying heat step
     heat_implicit: bool  # time.heat_integrator = "implicit" (solver/implicit_heat.py)
+    sparse_rows: bool  # time.implicit_rows: the 3D rows by blocks (solver/fields.py row_field)
     top_loss: bool  # thermal.top_surface = "chamber" (physics/thermal.py)
     chamber_T: float  # K
     emissivity: float
@@ -166,6 +168,20 @@ def flip_share(case: Case, dt: float) -> float:
     if sv.blend_per == "step" or dt <= 0.0 or dt == sv.flip_ratio_dt_s:
         return sv.flip_ratio
     return sv.flip_ratio ** (dt / sv.flip_ratio_dt_s)
+
+
+DENSE_ROWS_MAX_BYTES = 2**30  # time.implicit_rows = "auto": blocks above this
+
+
+def sparse_rows(case: Case, grid: tuple[int, ...]) -> bool:
+    """Whether the 3D implicit rows are stored by blocks (``time.implicit_rows``): asked for,
+    or "auto" where the dense rows (WIDTH^3 neighbours, 1 + 9 values each, f64) pass
+    DENSE_ROWS_MAX_BYTES."""
+    rows = case.time.implicit_rows
+    if case.domain.dim != 3 or not case.implicit_mechanics() or rows == "dense":
+        return False
+    dense_bytes = math.prod(grid) * ROW_WIDTH**3 * 8 * (1 + 9)
+    return rows == "blocks" or dense_bytes > DENSE_ROWS_MAX_BYTES
 
 
 def step_config(
@@ -256,6 +272,7 @@ def step_config(
         else 0.0,
         subgrid_rate=case.thermal.subgrid_filter / filter_limit if thermal else 0.0,
         heat_implicit=case.implicit_heat(),
+        sparse_rows=sparse_rows(case, (scene.nx, scene.ny, scene.nz)[: case.domain.dim]),
         top_loss=thermal and case.thermal.top_surface == "chamber",
         chamber_T=case.thermal.chamber_temperature_C() + KELVIN,
         emissivity=case.thermal.emissivity,

@@ -4,10 +4,12 @@
 Two molten PA12 spheres, R = 20 um, touching at a point in a 120 x 60 x 60 um box (surface
 tension on, no gravity), implicit steps at the "auto" step, at h = 4, 3 and 2.5 um (``--quick``:
 4 only), each with the direct solver (CHOLMOD) and with AMG-CG (pyamg's smoothed aggregation
-with the rigid-body modes). After one step (which compiles), ``--steps`` steps are timed: the
-wall time per step and per Newton linear solve, Newton iterations, CG iterations per solve
-(0: the factorization alone), the unknowns, and the
-implicit grid rows' memory per grid node, per active node (one with unknowns) and per point.
+with the rigid-body modes), the direct one also with the rows stored by blocks
+(``time.implicit_rows = "blocks"``) beside dense ones. After one step (which compiles),
+``--steps`` steps are timed: the wall time per step and per Newton linear solve, Newton
+iterations, CG iterations per solve (0: the factorization alone), the unknowns, and the
+implicit grid fields' memory (the rows in the blocks they were written in, the rest over the
+grid) per grid node, per active node (one with unknowns) and per point.
 Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/implicit.md, "In
 3D")."""
 
@@ -21,12 +23,14 @@ import numpy as np
 from ..config import case_from_dict
 from ..io.atomic import atomic_write_text, write_rows
 from ..solver import linear_solve
+from ..solver.implicit import allocated_row_nodes
 from ..solver.simulation import Simulation
 
 SPACINGS_UM = (4.0, 3.0, 2.5)
 COLUMNS = [
     "h_um",
     "solver",
+    "rows",
     "points",
     "unknowns",
     "steps",
@@ -41,8 +45,9 @@ COLUMNS = [
 ]
 
 
-def pair_case(h_um: float, solver: str) -> dict:
-    """The sphere pair at spacing h_um with time.linear_solver = solver."""
+def pair_case(h_um: float, solver: str, rows: str = "dense") -> dict:
+    """The sphere pair at spacing h_um with time.linear_solver = solver and time.implicit_rows
+    = rows."""
     spheres = [
         {"center_um": [x, 30.0, 30.0], "radius_um": 20.0, "temperature_C": 200.0}
         for x in (40.0, 80.0)
@@ -52,24 +57,33 @@ def pair_case(h_um: float, solver: str) -> dict:
         "domain": {"dim": 3, "width_um": 120.0, "height_um": 60.0, "depth_um": 60.0},
         "bodies": spheres,
         "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0, 0.0]},
-        "time": {"integrator": "implicit", "linear_solver": solver, "end_s": 1.0},
+        "time": {
+            "integrator": "implicit",
+            "linear_solver": solver,
+            "implicit_rows": rows,
+            "end_s": 1.0,
+        },
         "output": {"frames": 1},
     }
 
 
 def _grid_bytes(sim: Simulation) -> int:
-    """The implicit step's grid fields (rows, force, numbering), in bytes."""
-    imp = sim.state.implicit
+    """The implicit step's grid fields in bytes: the rows where they hold storage (in 3D the
+    blocks written, solver/fields.py ``row_field``), and the force and numbering over the
+    grid."""
+    imp, dim = sim.state.implicit, sim.state.cfg.dim
     total = 0
     for f in (imp.fixed, imp.tangent):
-        total += 8 * int(np.prod(f.shape))
-    dim = sim.state.cfg.dim
-    nodes = int(np.prod(imp.fixed.shape[:dim]))
-    return total + nodes * dim * (8 + 4 + 4)  # internal force, free, dof
+        total += 8 * allocated_row_nodes(f, dim) * int(np.prod(f.shape[dim:]))
+    return total + _grid_nodes(sim) * dim * (8 + 4 + 4)  # internal force, free, dof
 
 
-def measure(h_um: float, solver: str, steps: int) -> dict:
-    sim = Simulation(case_from_dict(pair_case(h_um, solver)))
+def _grid_nodes(sim: Simulation) -> int:
+    return int(np.prod(sim.state.implicit.free.shape))
+
+
+def measure(h_um: float, solver: str, steps: int, rows: str = "dense") -> dict:
+    sim = Simulation(case_from_dict(pair_case(h_um, solver, rows)))
     sim.advance(1)  # compiles the step's kernels
     spent = {"s": 0.0, "n": 0}
     solve = linear_solve.LinearSolver.solve
@@ -93,11 +107,12 @@ def measure(h_um: float, solver: str, steps: int) -> dict:
         linear_solve.LinearSolver.solve = solve
     dim = sim.state.cfg.dim
     grid = _grid_bytes(sim)
-    nodes = int(np.prod(sim.state.implicit.fixed.shape[:dim]))
+    nodes = _grid_nodes(sim)
     unknowns = sim.implicit.last.unknowns
     active = int((sim.state.implicit.free.to_numpy().reshape(-1, dim).max(axis=1) > 0).sum())
     return {
         "h_um": h_um,
+        "rows": rows,
         "solver": sim.implicit.last.solver,
         "points": sim.scene.n_points,
         "unknowns": unknowns,
@@ -128,11 +143,12 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for h in SPACINGS_UM[:1] if args.quick else SPACINGS_UM:
-        for solver in ("direct", "amg"):
-            rows.append(measure(h, solver, args.steps))
+        for solver, storage in (("direct", "dense"), ("direct", "blocks"), ("amg", "dense")):
+            rows.append(measure(h, solver, args.steps, storage))
             r = rows[-1]
             print(
-                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['unknowns']:7d} unknowns "
+                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['rows']:6s} "
+                f"{r['unknowns']:7d} unknowns "
                 f"{r['wall_per_step_s']:7.2f} s/step {r['wall_per_solve_s']:7.3f} s/solve "
                 f"{r['newton_iterations_per_step']:5.2f} Newton/step "
                 f"{r['cg_iterations_per_solve']:5.1f} CG/solve  "

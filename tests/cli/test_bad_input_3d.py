@@ -58,6 +58,13 @@ BAD = [
     ),
     ("three_coordinates_in_2d", PAIR_2D.format(extra="", centre="[20, 20, 5]"), "center_um"),
     (
+        "row_blocks_in_2d",
+        PAIR_2D.format(
+            extra='[time]\nintegrator = "implicit"\nimplicit_rows = "blocks"', centre="[20, 20]"
+        ),
+        'time.implicit_rows = "blocks"',
+    ),
+    (
         "front_wall_in_2d",
         PAIR_2D.format(extra='[boundary.front]\nthermal = "fixed"', centre="[20, 20]"),
         "boundary.front",
