@@ -138,6 +138,15 @@ class NeckMeasures:
             / np.bincount(body, weights=m, minlength=n_b)[:, None]
         )
 
+    def colour_weights(self) -> np.ndarray:
+        """Each point's share of the colour the force contours, per node of its stencil's
+        unit weight: m / (rho V_cell) for the mass colour, V0 J / V_cell for the volume one."""
+        cfg = self.state.cfg
+        if cfg.se.volume_colour:
+            pt = self.point_arrays(("volume0", "J"))
+            return pt["volume0"] * pt["J"] / cfg.cell_volume
+        return self._mass / (cfg.rho_ref * cfg.cell_volume)
+
     def pair_necks_m(self) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
         reads it but on the colour of the contact's two bodies alone (raw or filtered as
@@ -147,12 +156,8 @@ class NeckMeasures:
         :meth:`necks_m` on the colour for a case of two bodies."""
         if not self.contacts:
             return []
-        pt, cfg = self.point_arrays(), self.state.cfg
-        x = pt["x"]
-        if cfg.se.volume_colour:
-            weight = pt["volume0"] * pt["J"] / cfg.cell_volume
-        else:
-            weight = self._mass / (cfg.rho_ref * cfg.cell_volume)
+        cfg = self.state.cfg
+        x, weight = self.point_arrays(("x",))["x"], self.colour_weights()
         body = self.scene.body
         order = np.argsort(body, kind="stable")
         bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))

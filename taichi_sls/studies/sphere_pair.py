@@ -103,12 +103,7 @@ def full_pair_points(sim: Simulation, octant: bool) -> tuple[np.ndarray, np.ndar
     """The pair's point positions (m) and colour weights (the mass colour m / (rho V_cell), or
     the volume colour where the force uses it), and which of them are the first sphere's count;
     an octant's points unfolded over its three mirror planes into the whole pair."""
-    cfg, pt = sim.state.cfg, sim.point_arrays(("x", "volume0", "J"))
-    if cfg.se.volume_colour:
-        weight = pt["volume0"] * pt["J"] / cfg.cell_volume
-    else:
-        weight = sim._mass / (cfg.rho_ref * cfg.cell_volume)
-    x = pt["x"]
+    x, weight = sim.point_arrays(("x",))["x"], sim.colour_weights()
     if not octant:
         order = np.argsort(sim.scene.body, kind="stable")
         return x[order], weight[order], int(np.sum(sim.scene.body == 0))
