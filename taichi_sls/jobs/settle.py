@@ -75,9 +75,7 @@ def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, floa
     if not done:
         raise SimulationError(
             f"contact.settle: the bodies had not settled by time.max_s = {case.time.max_s:g} s "
-            f"(kinetic ratio {last['kinetic_ratio']:.2g}, time.settled_kinetic_fraction "
-            f"{case.time.settled_kinetic_fraction:g}); raise time.max_s or set contact.settle "
-            "= false"
+            f"({_unsettled_cause(last, case)})"
         )
     record = {
         "time_s": sim.t,
@@ -95,3 +93,21 @@ def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, floa
     lasers_absorb(sim, True)
     sim.restart_clock()
     return record
+
+
+def _unsettled_cause(last: dict[str, float], case: Case) -> str:
+    """Why the settle rule did not hold at the last frame, and what to change: a scene at or
+    above its crystallisation temperature (a bed at its melting onset) is never solid, however
+    still it is; otherwise its kinetic energy has not decayed within the time allowed."""
+    solid_below = min(m.crystallization_C for m in case.materials.values())
+    if last["molten_fraction"] > 0.0 or last["T_max_C"] > solid_below:
+        return (
+            f"not solid: peak {last['T_max_C']:.2f} C against crystallisation at "
+            f"{solid_below:g} C, molten fraction {last['molten_fraction']:.2g}; a scene at or "
+            "above its crystallisation temperature never reads settled: start it cooler or set "
+            "contact.settle = false"
+        )
+    return (
+        f"kinetic ratio {last['kinetic_ratio']:.2g}, time.settled_kinetic_fraction "
+        f"{case.time.settled_kinetic_fraction:g}; raise time.max_s or set contact.settle = false"
+    )

@@ -52,3 +52,20 @@ def test_a_pair_that_never_settles_ends_with_its_error(tmp_path, capsys):
     assert code == EXIT_CODES["failed"] != 0
     assert "error: contact.settle: the bodies had not settled by time.max_s = 3e-05 s" in err
     assert "Traceback" not in err and "KeyError" not in err
+    assert "raise time.max_s" in err  # the pair is solid: the kinetic energy had not decayed
+
+
+def test_settling_a_scene_above_its_crystallisation_names_the_cause(tmp_path, capsys):
+    """A pair held above its crystallisation temperature (initial 150 C against the paper's
+    146 C) is never solid, so contact.settle cannot end however still it is: the error says
+    so, with the temperatures, instead of blaming the kinetic energy."""
+    from taichi_sls.cli import EXIT_CODES, main
+
+    sets = ["grid.spacing_um=4", "time.max_s=3e-5", "output.gif=false"]
+    sets += ["thermal.initial_C=150", "boundary.bottom.temperature_C=150"]
+    args = ["run", str(ROOT / "cases" / "power25W_resolved.toml"), "--out", str(tmp_path / "o")]
+    code = main(args + ["--no-progress"] + [a for s in sets for a in ("--set", s)])
+    err = capsys.readouterr().err
+    assert code == EXIT_CODES["failed"] != 0
+    assert "had not settled" in err and "not solid: peak 150.00 C" in err, err
+    assert "crystallisation at 146 C" in err and "Traceback" not in err
