@@ -182,7 +182,7 @@ def plot_sensitivity(summary: dict[str, Any], png: str | Path) -> Path:
         Patch(color="C3", label="upper level (x2, +20 %, +3 K)"),
         Patch(color="0.6", label="another bed draw: the noise"),
     ]
-    ax.legend(handles=handles, fontsize=8, loc="upper left")
+    ax.legend(handles=handles, fontsize=8, loc="lower right")
     ax.axvline(0, color="k", lw=0.8)
     ref = summary["reference"]
     title = "sensitivity of the density a layer gains over its layer time"
