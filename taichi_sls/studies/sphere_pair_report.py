@@ -126,7 +126,7 @@ def draw(runs: list[dict], png: Path) -> None:
     import matplotlib.pyplot as plt
 
     fine = runs[-1]
-    tau = np.linspace(0.0, float(fine["tau"].max()), 400)
+    tau = np.linspace(0.0, max(float(r["tau"].max()) for r in runs), 400)
     x0 = float(fine["x_over_R"][0])
     fig, ax = plt.subplots(figsize=(7.0, 4.6), dpi=110)
     for i, run in enumerate(runs):

@@ -3,6 +3,7 @@ its packing fraction against the published value, the [bed] table of a 3D case (
 CSV spheres) and its one-line errors (numpy only, no simulation)."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,8 @@ from taichi_sls.config import CaseError, case_from_dict, case_to_dict
 from taichi_sls.config.deposition import lognormal_diameters
 from taichi_sls.config.deposition3d import deposit_spheres
 from taichi_sls.config.packing3d import packing_fractions_3d, slab_volume, volume_in_box
+
+ROOT_CASES = Path(__file__).resolve().parents[2] / "cases"
 
 # Random sequential deposition with rolling of equal spheres (each sphere rolls to rest on
 # three) packs at 0.58 in the bulk: Visscher & Bolsterli 1972 (Nature 239, 504), and Jullien &
@@ -230,3 +233,14 @@ def test_a_beam_left_at_mid_depth_follows_the_depth_the_bed_fits():
     )
     assert case.domain.depth() == pytest.approx(120.0)
     assert case.lasers[0].z_start_um == pytest.approx(60.0)
+
+
+def test_the_gpu_layer_case_loads():
+    """cases/bed3d_hatch_gpu.toml (the larger layer documented for a GPU, not run here) is a
+    valid case: 400 spheres over 240 x 240 um at h = 2 um under three hatched tracks."""
+    from taichi_sls.config import load_case
+
+    case = load_case(ROOT_CASES / "bed3d_hatch_gpu.toml")
+    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report()["spheres"] == 400
+    assert case.grid.spacing_um == 2.0
+    assert case.lasers[0].tracks == 3 and case.lasers[0].hatch_um == 80.0
