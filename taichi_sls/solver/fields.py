@@ -180,9 +180,8 @@ class ImplicitFields:
         row = grid + (WIDTH,) * cfg.dim
         # 3D, time.implicit_rows: the rows by blocks of nodes that the step writes
         # (solver/implicit.py clear_rows empties them)
-        self.sparse_rows = cfg.sparse_rows
-        self.fixed = row_field(grid, (WIDTH,) * cfg.dim, self.sparse_rows)
-        self.tangent = row_field(grid, (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim), self.sparse_rows)
+        self.fixed = row_field(grid, (WIDTH,) * cfg.dim, cfg.sparse_rows)
+        self.tangent = row_field(grid, (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim), cfg.sparse_rows)
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
         # which nodes are unknowns and their numbers, one struct: the host reads the kinds and

@@ -107,7 +107,7 @@ def _clear_matrix(K: ti.template(), I, dim: ti.template()):
 
 def begin(st: State) -> None:
     """Everything of the step before the Newton loop (module docstring)."""
-    if st.implicit.sparse_rows:
+    if st.cfg.sparse_rows:
         clear_rows(st.implicit.fixed)
     in_order(st, _begin)
 
@@ -141,7 +141,7 @@ def _begin(st: ti.template()):
     nd = ti.static(st.nodes)
     dt = st.scalars.dt[None]
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(not st.implicit.sparse_rows):
+        if ti.static(not st.cfg.sparse_rows):
             _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
         m = nd.mass[I]
         vn = ti.Vector(ZERO_VECTOR[st.cfg.dim])
@@ -202,7 +202,7 @@ def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.
 def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(not st.implicit.sparse_rows):
+        if ti.static(not st.cfg.sparse_rows):
             if st.implicit.with_tangent[None]:
                 _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
         st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
@@ -312,7 +312,7 @@ class ImplicitStepper:
         entries."""
         st = self.st
         st.implicit.with_tangent[None] = int(tangent)
-        if tangent and st.implicit.sparse_rows:
+        if tangent and st.cfg.sparse_rows:
             clear_rows(st.implicit.tangent)
         internal_force(st, v, sys_.dof_node)
         f_int = np.empty(sys_.n)
