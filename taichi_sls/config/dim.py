@@ -131,11 +131,6 @@ def _refuse_in_3d(case: Any) -> None:
             f"bed.previous_layer = {case.bed.previous_layer!r} with domain.dim = 3: layer files "
             f"are {not_yet}; allowed in 3D: a generated bed or bed.csv of spheres"
         )
-    if case.thermal.top_surface != "insulated":
-        raise CaseError(
-            f"thermal.top_surface = {case.thermal.top_surface!r} with domain.dim = 3: the loss "
-            f'through each grid column is {not_yet}; allowed in 3D: "insulated"'
-        )
     if case.solver.layout == "blocks":
         raise CaseError(
             f'solver.layout = "blocks" with domain.dim = 3: the race-free colouring is 4 '

@@ -161,13 +161,15 @@ def _draw_histogram(ax: Axes, rows: list[dict[str, Any]]) -> None:
 def _draw_growth(
     ax: Axes, rows: list[dict[str, Any]], kinds: list[str], neck_growth: float | None
 ) -> None:
-    """Each contact's neck growth (final over initial) against its x, coloured by outcome."""
+    """Each contact's neck growth (final over initial) against its x, coloured by outcome; a
+    contact whose initial section held no point (a 3D neck below the grid's reach) has no growth
+    to draw and is left out."""
     x = np.array([r["x_um"] for r in rows], dtype=float)
-    growth = 100.0 * (
-        np.array([r["neck_final_um"] for r in rows], dtype=float)
-        / np.array([r["neck_initial_um"] for r in rows], dtype=float)
-        - 1.0
-    )
+    initial = np.array([r["neck_initial_um"] for r in rows], dtype=float)
+    final = np.array([r["neck_final_um"] for r in rows], dtype=float)
+    growth = np.full_like(initial, np.nan)
+    seen = initial > 0.0
+    growth[seen] = 100.0 * (final[seen] / initial[seen] - 1.0)
     for kind, colour in KINDS.items():
         sel = np.array([k == kind for k in kinds])
         if sel.any():

@@ -41,8 +41,9 @@ to them are updated as ``g2p_heat`` says, so that none is pushed past the wall t
 Top-surface loss (``cfg.top_loss``, ``thermal.top_surface = "chamber"``): the layer's top surface
 loses q(T) = h_c (T - T_ch) + eps sigma (T^4 - T_ch^4) per area to the chamber. Each node column
 is exposed over its share of the domain's width (its projected top, the area a rough surface
-presents to the chamber); T is the capacity-weighted temperature of the column's top three nodes
-(the topmost holding material and the two below it, fixed ones excluded), and the column's loss
+presents to the chamber; in 3D each (i, k) column over its share of the bed plane); T is the
+capacity-weighted temperature of the column's top three nodes (the topmost holding material and
+the two below it, fixed ones excluded), and the column's loss
 is taken from them in proportion to their capacities, so the skin cools as one. It enters the
 nodes' heat rate as the laser's heat does, and is counted in ``heat_out``: the energy balance
 still holds to round-off.
@@ -210,35 +211,63 @@ def surface_flux(cfg: ti.template(), T):
 
 
 @ti.func
-def top_loss_column(cfg: ti.template(), nd: ti.template(), i, j_lo, j_hi, dt):
-    """Take column i's top-surface loss over dt from its skin nodes' heat rates (module
-    docstring); returns the heat lost (J per depth). Rows j_lo <= j < j_hi hold the material."""
-    x = (i - cfg.off) * cfg.h
-    width = ti.max(ti.min(x + 0.5 * cfg.h, cfg.ncx * cfg.h) - ti.max(x - 0.5 * cfg.h, 0.0), 0.0)
+def _open_extent(cfg: ti.template(), index, cells):
+    """The length of node ``index``'s cell share that lies inside [0, cells h] along one axis."""
+    x = (index - cfg.off) * cfg.h
+    return ti.max(ti.min(x + 0.5 * cfg.h, cells * cfg.h) - ti.max(x - 0.5 * cfg.h, 0.0), 0.0)
+
+
+@ti.func
+def column_node(cfg: ti.template(), column, j):
+    """The node of ``column`` (i in 2D, (i, k) in 3D) at row j (y up)."""
+    if ti.static(cfg.dim == 3):
+        return ti.Vector([column[0], j, column[1]])
+    else:
+        return ti.Vector([column[0], j])
+
+
+@ti.func
+def column_area(cfg: ti.template(), column):
+    """The projected top a node column presents to the chamber: its share of the domain's
+    width (per depth) in 2D, of the bed plane's area in 3D."""
+    area = _open_extent(cfg, column[0], cfg.ncx)
+    if ti.static(cfg.dim == 3):
+        area *= _open_extent(cfg, column[1], cfg.ncz)
+    return area
+
+
+@ti.func
+def top_loss_column(cfg: ti.template(), nd: ti.template(), column, j_lo, j_hi, dt):
+    """Take a node column's top-surface loss over dt from its skin nodes' heat rates (module
+    docstring); returns the heat lost (J per depth in 2D, J in 3D). ``column`` is i in 2D,
+    (i, k) in 3D; rows j_lo <= j < j_hi hold the material."""
+    area = column_area(cfg, column)
     top = j_lo - 1
     for jj in range(j_hi - j_lo):  # from the top down to the first node holding material
         j = j_hi - 1 - jj
-        if top < j_lo and nd.heat_capacity[i, j] > 0.0:
+        if top < j_lo and nd.heat_capacity[column_node(cfg, column, j)] > 0.0:
             top = j
     lost = 0.0
-    if top >= j_lo and width > 0.0:
+    if top >= j_lo and area > 0.0:
         C = 0.0
         CT = 0.0
         for k in range(SKIN_NODES):
             j = top - k
             if j >= j_lo:
-                fixed, Tw = fixed_temperature(cfg, ti.Vector([i, j]))
+                node = column_node(cfg, column, j)
+                fixed, Tw = fixed_temperature(cfg, node)
                 if not fixed:
-                    C += nd.heat_capacity[i, j]
-                    CT += nd.heat_capacity[i, j] * nd.T[i, j]
+                    C += nd.heat_capacity[node]
+                    CT += nd.heat_capacity[node] * nd.T[node]
         if C > 0.0:
-            rate = width * surface_flux(cfg, CT / C)  # W per depth
+            rate = area * surface_flux(cfg, CT / C)  # W (per depth in 2D)
             for k in range(SKIN_NODES):
                 j = top - k
                 if j >= j_lo:
-                    fixed, Tw = fixed_temperature(cfg, ti.Vector([i, j]))
+                    node = column_node(cfg, column, j)
+                    fixed, Tw = fixed_temperature(cfg, node)
                     if not fixed:
-                        nd.heat_rate[i, j] -= rate * nd.heat_capacity[i, j] / C
+                        nd.heat_rate[node] -= rate * nd.heat_capacity[node] / C
             lost = rate * dt
     return lost
 

@@ -160,6 +160,15 @@ STUDIES = (
         case="hopper3d",
         on_request=True,
     ),
+    Study(  # the same pair turned by 45 deg in the plane
+        "hopper3d_45deg_r20",
+        (20,),
+        (20,),
+        "neck_tau1",
+        sets={"verification": {"hopper_taus": [0.5, 1.0, 2.0], "hopper_angle_deg": 45.0}},
+        case="hopper3d",
+        on_request=True,
+    ),
 )
 
 

@@ -89,7 +89,6 @@ REFUSED_IN_3D = [
         {"bodies": [{"shape": "polygon", "vertices_um": [[0, 0], [10, 0], [0, 10]]}]},
         'bodies[0].shape = "polygon"',
     ),
-    ({"thermal": {"top_surface": "chamber"}}, "thermal.top_surface = 'chamber'"),
     ({"solver": {"layout": "blocks"}}, 'solver.layout = "blocks"'),
     ({"lasers": [{"scan": "across", "speed_m_s": 5.0}]}, 'lasers[0].scan = "across"'),
     ({"grid": {"seeding": "area"}}, 'grid.seeding = "area"'),

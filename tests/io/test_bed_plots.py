@@ -7,6 +7,7 @@ tests/jobs/test_bed_outcome.py."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -245,3 +246,18 @@ def test_the_bed_outcome_draws_the_contacts_map_and_the_necks() -> None:
     growth = np.concatenate([line.get_ydata() for line in ax_growth.get_lines()[:3]])
     expected = [100.0 * (r["neck_final_um"] / r["neck_initial_um"] - 1.0) for r in rows]
     np.testing.assert_allclose(np.sort(growth), np.sort(expected))
+
+
+def test_the_growth_panel_leaves_out_a_contact_with_no_initial_neck() -> None:
+    """A 3D contact whose initial section held no point (neck 0) has no growth: it is left off
+    the growth panel (drawn as NaN, no division warning), the others drawn as before."""
+    rows, x = bed_rows(), layer_points()
+    rows[0] = {**rows[0], "neck_initial_um": 0.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = bed_outcome_figure(rows, x, neck_growth=0.05)
+    ax_growth = fig.axes[2]
+    growth = np.concatenate([line.get_ydata() for line in ax_growth.get_lines()[:3]])
+    expected = [100.0 * (r["neck_final_um"] / r["neck_initial_um"] - 1.0) for r in rows[1:]]
+    np.testing.assert_allclose(np.sort(growth[np.isfinite(growth)]), np.sort(expected))
+    assert np.isnan(growth).sum() == 1

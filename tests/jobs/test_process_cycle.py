@@ -25,6 +25,21 @@ def test_machine_layer_is_a_hatched_layer_at_a_machine_setting():
     assert case.time.end_s > 1000 * scan_end  # the layer time is the hold
 
 
+def test_machine_layer3d_is_the_machine_cycle_on_spheres():
+    """The 3D layer: machine_layer's bed, chamber, setting and layer time on deposited spheres,
+    hatched in the bed plane (two tracks along x, 0.1 mm apart), contacts settled."""
+    case, flat = load_case("machine_layer3d"), load_case("machine_layer")
+    las, las_2d = case.lasers[0], flat.lasers[0]
+    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report()["spheres"] == 48
+    assert las.direction == "x" and las.tracks == 2 and las.hatch_um == las_2d.hatch_um
+    assert (las.power_W, las.speed_m_s) == (las_2d.power_W, las_2d.speed_m_s)
+    for key in ("initial_C", "top_surface", "chamber_C", "emissivity", "convection_W_m2K"):
+        assert getattr(case.thermal, key) == getattr(flat.thermal, key), key
+    assert case.boundary.bottom.temperature_C == 172.0 and case.contact.settle
+    assert case.materials["PA12"].crystallization_kinetics is not None
+    assert case.time.end_s == flat.time.end_s == 10.0
+
+
 def test_the_progress_bar_shows_the_scan_then_the_hold(capsys):
     for t, phase in ((1e-3, "scan, "), (2.0, "hold, ")):
         bar = Progress(10.0, 0.0, adaptive=True, lasers_off_s=6e-3)
