@@ -19,7 +19,7 @@ class SimulationError(RuntimeError):
 
 class Guard:
     """Checks, in the order a failing run usually breaks them; the first one that fails names
-    the problem. ``T_floor_K``: the coldest start or fixed wall (conduction obeys a maximum
+    the problem. ``T_floor_K``: the coldest start, fixed wall or chamber (conduction obeys a maximum
     principle); ``energy_tol``: the energy balance's round-off bound for the precision."""
 
     # a Jacobian beyond this is no longer a small-strain continuum, a point moving more than this
@@ -109,7 +109,7 @@ class Guard:
             worst = np.maximum(self.T_floor_K - T, T - self.T_ABSURD_K)
             problem = (
                 f"temperature {T[np.argmax(worst)] - KELVIN:.1f} C outside the physical range "
-                f"[{self.T_floor_K - KELVIN:.1f} C (coldest start or wall), "
+                f"[{self.T_floor_K - KELVIN:.1f} C (coldest start, wall or chamber), "
                 f"{self.T_ABSURD_K - KELVIN:.0f} C] at {self._where(worst)}",
                 f"the thermal limit; {hint}",
             )

@@ -153,6 +153,8 @@ class Simulation(NeckMeasures):
         # points again as they flow, and a checkpoint keeps that order
         self.point_order = np.arange(self.scene.n_points)
         walls = [w.temperature_C for w in case.boundary.walls(cfg.dim) if w.thermal == "fixed"]
+        if case.thermal.top_surface == "chamber":  # the top surface relaxes towards it
+            walls.append(case.thermal.chamber_temperature_C())
         coldest = min([float(self.scene.T0_C.min()), *walls])
         # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32
         self.guard = Guard(
