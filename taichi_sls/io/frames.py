@@ -160,6 +160,16 @@ def _pixels(
     return on, ij
 
 
+def frame_time_label(t_s: float) -> str:
+    """A frame's title: the time in us below 1 ms (the paper's pulses), then ms, then s (a
+    layer time of seconds reads "t = 10 s", not in millions of us)."""
+    if t_s < 1e-3:
+        return f"t = {t_s * 1e6:.1f} us"
+    if t_s < 1.0:
+        return f"t = {t_s * 1e3:.4g} ms"
+    return f"t = {t_s:.4g} s"
+
+
 def save_png(fig: Figure, path: Path, dpi: int) -> None:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
@@ -328,7 +338,7 @@ class FramePainter:
                 )
             except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
                 self._contour = None
-        self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
+        self._fig.suptitle(frame_time_label(t_s))
 
     def save(self, path: Path, dpi: int) -> None:
         save_png(self._fig, path, dpi)

@@ -31,7 +31,7 @@ from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.ndimage import zoom
 
-from .frames import MELT_LEVEL, _finite_range, save_png, temperature_cmap
+from .frames import MELT_LEVEL, _finite_range, frame_time_label, save_png, temperature_cmap
 from .surface3d import SURFACE_LEVEL, ColourGrid, Surface
 
 # the light: from above (y), in front (-z: the viewer's side) and to the left (-x)
@@ -200,7 +200,7 @@ class Frame3DPainter:
                 antialiased=False,  # a third of the time; no seams at 51,000 triangles
             )
             self._ax_s.add_collection3d(self._mesh)
-        self._fig.suptitle(f"t = {t_s * 1e6:.1f} us")
+        self._fig.suptitle(frame_time_label(t_s))
 
     def save(self, path: Path, dpi: int) -> None:
         save_png(self._fig, path, dpi)

@@ -8,8 +8,8 @@ body touching every wall -- and classifies each row:
 - ``stable``: ran to its end, the guard silent, and the independent checks below pass;
 - ``caught``: the guard stopped it (its message is recorded);
 - ``WRONG``: ran to its end with the guard silent, but an independent check fails: energy balance
-  beyond 1e-6, a temperature below the coldest start, wall or chamber, J outside (0, 20), a non-finite
-  monitor. The goal is no such row.
+  beyond 1e-6, a temperature below the coldest start, wall or chamber, J outside (0, 20), a
+  non-finite monitor. The goal is no such row.
 
 Writes ``robustness.csv`` and ``robustness.md`` (the table of docs/robustness.md) to the output
 folder.

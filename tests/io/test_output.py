@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
-from taichi_sls.io.frames import MATERIAL_LEVEL, material_raster
+from taichi_sls.io.frames import MATERIAL_LEVEL, frame_time_label, material_raster
 from taichi_sls.io.series import plot_series
 from taichi_sls.io.vtu import VtuWriter, point_data, stress_invariants
 from taichi_sls.io.writer import OutputWriter
@@ -349,3 +349,12 @@ def test_vtu_refuses_an_array_of_the_wrong_length(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="J has 3 tuples"):
         VtuWriter(tmp_path).write(0, 0.0, x, {"T_C": np.zeros(len(x)), "J": np.ones(3)})
     assert not (tmp_path / "vtu" / "points_0000.vtu").exists()
+
+
+@pytest.mark.parametrize(
+    ("t_s", "label"),
+    [(0.0, "t = 0.0 us"), (2.5e-4, "t = 250.0 us"), (5.623e-3, "t = 5.623 ms"), (10.0, "t = 10 s")],
+)
+def test_frame_titles_read_in_the_unit_of_their_time(t_s: float, label: str) -> None:
+    """A frame of a pulse reads in us, a layer time's in ms or s (not 10000000.0 us)."""
+    assert frame_time_label(t_s) == label
