@@ -135,6 +135,12 @@ def test_hatch_keys_refused_with_key_value_and_allowed(laser, key):
 # ----------------------------------------------------------------------------- top surface
 
 
+# the slab: 40 um of the default PA12's solid, the parameters of the exact series it is
+# checked against (m, W/(m K), kg/m^3, J/(kg K))
+SLAB_M, CONDUCTIVITY, DENSITY, HEAT_CAPACITY = 40e-6, 0.28, 1020.0, 2700.0
+BIOT_CONVECTION = 0.3 * CONDUCTIVITY / SLAB_M  # h_c at Bi = 0.3 (W/(m^2 K))
+
+
 def _slab_case(thermal: dict, depth_um: float = 40.0, **extra):
     return make_case(
         deep_update(
@@ -275,8 +281,9 @@ def test_a_long_step_never_cools_a_thin_skin_past_the_chamber():
     assert lost < 40e-6 * q * sim.dt / 3.0
     # to the solve's round-off: conduction outweighs the capacity by k dt / (rho c h^2) ~ 6e3 in
     # a 1 s step, and the balance rounds at eps times that (measured 4e-13)
-    k, rho, c, h = 0.28, 1020.0, 2700.0, 4e-6
-    bound = np.finfo(float).eps * (1.0 + k * sim.dt / (rho * c * h * h))
+    h = sim.state.cfg.h
+    spread = CONDUCTIVITY * sim.dt / (DENSITY * HEAT_CAPACITY * h * h)
+    bound = np.finfo(float).eps * (1.0 + spread)
     assert abs(H0 - m["enthalpy_J_per_m"] - lost) / H0 < bound
 
 
@@ -302,8 +309,6 @@ def _slab_mean_exact(bi: float, fo: float, terms: int = 60) -> float:
 def _slab_cooled(h_um: float) -> tuple[float, float]:
     """A 40 um slab from 200 C, convection only (Bi = h L / k = 0.3) to a 170 C chamber, 20 ms,
     on grid h_um: (mean temperature, the exact series' mean) in C."""
-    L, k, rho, c = 40e-6, 0.28, 1020.0, 2700.0
-    hc = 0.3 * k / L
     sim = Simulation(
         _slab_case(
             {
@@ -311,21 +316,28 @@ def _slab_cooled(h_um: float) -> tuple[float, float]:
                 "top_surface": "chamber",
                 "chamber_C": 170.0,
                 "emissivity": 0.0,
-                "convection_W_m2K": hc,
+                "convection_W_m2K": BIOT_CONVECTION,
             },
             grid={"spacing_um": h_um},
             materials={"PA12": {"melt_C": 300.0, "crystallization_C": 290.0}},
         )
     )
+    mean, exact, t = _cool_for_20ms(sim)
+    print(f"h = {h_um} um: mean {mean:.4f} C, exact {exact:.4f} C after {t:.4g} s")
+    return mean, exact
+
+
+def _cool_for_20ms(sim: Simulation) -> tuple[float, float, float]:
+    """Step the slab from 200 C (Bi = 0.3 to 170 C) for 20 ms: (mean temperature, the exact
+    series' mean, t)."""
     n = int(round(20e-3 / sim.dt))
     sim.advance(n)
     t = n * sim.dt
     pt = sim.state.points
     mass = pt.mass.to_numpy()
     mean = float((mass * (pt.T.to_numpy() - KELVIN)).sum() / mass.sum())
-    exact = 170.0 + 30.0 * _slab_mean_exact(0.3, k * t / (rho * c * L * L))
-    print(f"h = {h_um} um: mean {mean:.4f} C, exact {exact:.4f} C after {t:.4g} s ({n} steps)")
-    return mean, exact
+    fourier = CONDUCTIVITY * t / (DENSITY * HEAT_CAPACITY * SLAB_M**2)
+    return mean, 170.0 + 30.0 * _slab_mean_exact(0.3, fourier), t
 
 
 def test_top_loss_convection_against_the_slab_solution():
@@ -387,24 +399,17 @@ def test_top_loss_in_3d_against_the_slab_solution():
     """The 3D slab (uniform along z) cooled by convection against the exact series, as the 2D
     slab above: under 4 % of the drop at h = 4 um, and within 1 % of the drop of the 2D slab's
     mean (the two differ only by their time steps, the 3D one smaller)."""
-    L, k, rho, c = 40e-6, 0.28, 1020.0, 2700.0
     thermal = {
         "initial_C": 200.0,
         "top_surface": "chamber",
         "chamber_C": 170.0,
         "emissivity": 0.0,
-        "convection_W_m2K": 0.3 * k / L,
+        "convection_W_m2K": BIOT_CONVECTION,
     }
     sim = Simulation(
         _slab3d_case(thermal, materials={"PA12": {"melt_C": 300.0, "crystallization_C": 290.0}})
     )
-    n = int(round(20e-3 / sim.dt))
-    sim.advance(n)
-    t = n * sim.dt
-    pt = sim.state.points
-    mass = pt.mass.to_numpy()
-    mean = float((mass * (pt.T.to_numpy() - KELVIN)).sum() / mass.sum())
-    exact = 170.0 + 30.0 * _slab_mean_exact(0.3, k * t / (rho * c * L * L))
+    mean, exact, t = _cool_for_20ms(sim)
     mean_2d, exact_2d = _slab_cooled(4.0)
     print(f"3D: mean {mean:.4f} C, exact {exact:.4f} C after {t:.4g} s; 2D: {mean_2d:.4f} C")
     assert 200.0 - mean > 3.0
