@@ -4,6 +4,7 @@ message naming the quantity, the step, the time, the worst point and the likely 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -11,6 +12,18 @@ from ..physics.materials import KELVIN
 from .fields import NEVER, WATCHED, State
 from .monitor import Trouble, grid_reach
 from .step_config import T_RUNAWAY_K
+
+
+def temperature_floor_K(case: Any, dim: int, coldest_start_C: float) -> float:
+    """The coldest temperature a point may reach (K): its start's, a fixed wall's or the
+    chamber's that the top surface loses heat to (conduction obeys a maximum principle, and the
+    chamber draws the surface only towards its own temperature); -inf where heat is off."""
+    if not case.physics.thermal:
+        return -math.inf
+    walls = [w.temperature_C for w in case.boundary.walls(dim) if w.thermal == "fixed"]
+    if case.thermal.top_surface == "chamber":
+        walls.append(case.thermal.chamber_temperature_C())
+    return min([coldest_start_C, *walls]) + KELVIN
 
 
 class SimulationError(RuntimeError):

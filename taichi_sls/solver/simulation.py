@@ -19,7 +19,7 @@ from .blocks import BlockPlan
 from .contacts import touching
 from .extrapolation import ExtrapolatedStepper
 from .fields import State
-from .guard import Guard
+from .guard import Guard, temperature_floor_K
 from .handover import Handover, explicit_view
 from .implicit import ImplicitStepper
 from .monitor import point_monitors
@@ -152,16 +152,12 @@ class Simulation(NeckMeasures):
         # each point's index in the order the run started with: the blocks layout sorts the
         # points again as they flow, and a checkpoint keeps that order
         self.point_order = np.arange(self.scene.n_points)
-        walls = [w.temperature_C for w in case.boundary.walls(cfg.dim) if w.thermal == "fixed"]
-        if case.thermal.top_surface == "chamber":  # the top surface relaxes towards it
-            walls.append(case.thermal.chamber_temperature_C())
-        coldest = min([float(self.scene.T0_C.min()), *walls])
         # the energy balance holds to round-off: ~1e-12 in f64, ~1e-6 in f32
         self.guard = Guard(
             self.state,
             self.dt,
             self.dt_limits,
-            T_floor_K=coldest + KELVIN if case.physics.thermal else -math.inf,
+            T_floor_K=temperature_floor_K(case, cfg.dim, float(self.scene.T0_C.min())),
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
         self._pair = len(case.bodies) >= 2

@@ -12,6 +12,7 @@ from scipy.special import erf
 from taichi_sls.config import CaseError
 from taichi_sls.physics.thermal import STEFAN_BOLTZMANN
 from taichi_sls.solver.adaptive import laser_switch_times
+from taichi_sls.solver.guard import temperature_floor_K
 from taichi_sls.solver.simulation import Simulation
 
 KELVIN = 273.15
@@ -285,6 +286,14 @@ def test_a_long_step_never_cools_a_thin_skin_past_the_chamber():
     spread = CONDUCTIVITY * sim.dt / (DENSITY * HEAT_CAPACITY * h * h)
     bound = np.finfo(float).eps * (1.0 + spread)
     assert abs(H0 - m["enthalpy_J_per_m"] - lost) / H0 < bound
+
+
+def test_the_guard_floor_is_the_coldest_start_wall_or_chamber():
+    """A slab at 200 C cools towards a 172 C chamber: the guard's floor is the chamber's, not
+    the start's (before, a run cooling to its chamber was stopped as unphysical)."""
+    chamber = _slab_case({"initial_C": 200.0, "top_surface": "chamber", "chamber_C": 172.0})
+    assert temperature_floor_K(chamber, 2, 200.0) == 172.0 + KELVIN
+    assert temperature_floor_K(_slab_case({"initial_C": 200.0}), 2, 200.0) == 200.0 + KELVIN
 
 
 def test_top_loss_default_is_insulated():
