@@ -141,6 +141,7 @@ STUDIES = (
     Study("hopper_pa12", (10, 20), (10,), "neck_tau1"),  # the implicit integrator's
     Study("laplace3d", (10,), (10,), "pressure", on_request=True),
     Study("inviscid3d", (10,), (10,), "period", on_request=True),
+    Study("viscous_decay3d", (10,), (10,), "decay_rate", on_request=True),
     Study("hopper3d", (10,), (10,), "neck_tau1", on_request=True),  # 2 cells of periodic depth
     Study(
         "hopper3d_45deg",

@@ -297,6 +297,24 @@ def test_mushy_stefan_rejects_bad_temperatures():
 # ---------------------------------------------------------------------------------------------
 
 
+def test_viscous_sphere_decay_is_the_viscous_drop_limit():
+    """The l = 2 sphere's Stokes decay, 20 gamma / (19 eta R), is the limit of a drop of
+    viscosity lambda mu in a fluid mu (Rallison 1984: 40 (lambda + 1) gamma / ((2 lambda + 3)
+    (19 lambda + 16) mu R)) as the outer fluid vanishes, lambda -> infinity at fixed lambda mu."""
+    gamma, R, eta = 0.0363, 20e-6, 0.3
+    lam = 1e9
+    mu = eta / lam
+    drop = 40 * (lam + 1) * gamma / ((2 * lam + 3) * (19 * lam + 16) * mu * R)
+    assert ref.viscous_decay_rate_sphere(2, gamma, eta, R) == pytest.approx(drop, rel=1e-8)
+    assert ref.viscous_decay_rate_sphere(2, gamma, eta, R) == pytest.approx(
+        20 * gamma / (19 * eta * R), rel=1e-14
+    )
+    # mode 3: 3 * 5 * 7 / (2 * 33)
+    assert ref.viscous_decay_rate_sphere(3, gamma, eta, R) == pytest.approx(
+        105 / 66 * gamma / (eta * R), rel=1e-14
+    )
+
+
 def test_capillary_formulas():
     gamma, R, eta, rho = 1.5, 2e-5, 5e-3, 4000.0
     assert ref.disc_curvature(R) == pytest.approx(5e4)

@@ -9,7 +9,8 @@ input and ``numpy.ndarray`` otherwise.
 - :mod:`.heat`: erf half-space, spreading 2D Gaussian;
 - :mod:`.perzyna`: Perzyna overstress viscoplasticity;
 - :mod:`.stefan`: Stefan melting with a linear mushy zone;
-- :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc;
+- :mod:`.capillarity`: Laplace pressure, viscous and inviscid shape oscillations of a disc and
+  of a sphere;
 - :mod:`.hopper`: the coalescence of two equal viscous cylinders (Hopper 1984, 1990);
 - :mod:`.crystallization`: isothermal Avrami, non-isothermal Nakamura, DSC peak vs cooling rate;
 - :mod:`.viscosity`: the Arrhenius law of a melt's zero-shear viscosity.

@@ -49,6 +49,24 @@ def viscous_decay_rate(n: int, gamma: float, eta_N: float, R: float) -> float:
     return n * gamma / (2.0 * eta_N * R)
 
 
+def viscous_decay_rate_sphere(n: int, gamma: float, eta_N: float, R: float) -> float:
+    """Decay rate of shape mode n >= 2 (Legendre P_n) of a viscous sphere in vacuum, Stokes limit
+    (1/s): rate = n (n + 2)(2n + 1) gamma / (2 (2n^2 + 4n + 3) eta_N R); n = 2: 20 gamma /
+    (19 eta_N R).
+
+    Derived as :func:`viscous_decay_rate`, in 3D: Lamb's interior Stokes solution (Lamb 1932,
+    Hydrodynamics, sec. 336) with pressure the solid harmonic A r^n P_n and potential part
+    B r^n P_n; zero shear stress at r = R gives B = -C R^2 n (n + 2) / ((n + 1)(n - 1)),
+    C = A / (2 eta_N (2n + 3)); then sigma_rr(R) = -2 eta_N C R^n (2n^2 + 4n + 3) / (n + 1) P_n
+    balances the curvature's -gamma (n - 1)(n + 2) eps P_n / R, and R d eps/dt = u_r(R) =
+    -n C R^(n+1) (2n + 1) / ((n + 1)(n - 1)). Checked for n = 2 against the slow relaxation of a
+    drop of viscosity ratio lambda (Rallison 1984, Annu. Rev. Fluid Mech. 16: rate
+    40 (lambda + 1) gamma / ((2 lambda + 3)(19 lambda + 16) mu R)) as lambda -> infinity:
+    20 gamma / (19 eta R).
+    """
+    return n * (n + 2) * (2 * n + 1) * gamma / (2.0 * (2 * n * n + 4 * n + 3) * eta_N * R)
+
+
 def maxwell_decay_rate(newtonian_rate: float, tau: float) -> float:
     """Decay rate of a capillary shape mode of a Maxwell fluid (relaxation time tau) in the Stokes
     limit: s = lam/(1 + lam tau), lam the Newtonian rate of :func:`viscous_decay_rate`.
