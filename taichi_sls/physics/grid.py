@@ -22,6 +22,17 @@ def active(box: ti.template(), shrink: ti.template() = 0):
 
 
 @ti.func
+def bed_plane(box: ti.template()):
+    """The index ranges of the active region's node columns, across the bed plane: i in 2D,
+    (i, k) in 3D (y up), for ti.ndrange."""
+    ranges = active(box)
+    if ti.static(box.n == 6):
+        return ranges[0], ranges[2]
+    else:
+        return (ranges[0],)
+
+
+@ti.func
 def ramped_gamma(cfg: ti.template(), t):
     """gamma at time t: ``gamma_ramp_s`` > 0 lets it rise linearly from 0 (either method)."""
     gamma = cfg.gamma

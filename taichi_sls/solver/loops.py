@@ -7,7 +7,7 @@ the point's block (0 outside the blocks layout)."""
 
 from taichi_sls.backend import ti
 
-from ..physics.grid import active
+from ..physics.grid import active, bed_plane
 from ..physics.shape import stencil, stencil_base
 from ..physics.thermal import top_loss_column, wall_heat
 from .blocks import MARGIN, SIDE
@@ -113,20 +113,12 @@ def top_loss_in_order(st: ti.template()):
     """The top surface's loss to the chamber (physics/thermal.py), column by column; its total
     summed in column order by one thread, so that it repeats bit for bit."""
     dt_heat = heat_step(st)
-    ranges = active(st.box)
-    rows = ranges[1]
-    if ti.static(st.cfg.dim == 3):
-        if ti.static(st.cfg.parallel):
-            ti.loop_config(serialize=True)
-        for i, k in ti.ndrange(ranges[0], ranges[2]):
-            lost = top_loss_column(st.cfg, st.nodes, ti.Vector([i, k]), rows[0], rows[1], dt_heat)
-            st.scalars.heat_out[None] += lost
-    else:
-        if ti.static(st.cfg.parallel):
-            ti.loop_config(serialize=True)
-        for i in range(ranges[0][0], ranges[0][1]):
-            lost = top_loss_column(st.cfg, st.nodes, ti.Vector([i]), rows[0], rows[1], dt_heat)
-            st.scalars.heat_out[None] += lost
+    rows = active(st.box)[1]
+    if ti.static(st.cfg.parallel):
+        ti.loop_config(serialize=True)
+    for column in ti.grouped(ti.ndrange(*bed_plane(st.box))):
+        lost = top_loss_column(st.cfg, st.nodes, column, rows[0], rows[1], dt_heat)
+        st.scalars.heat_out[None] += lost
 
 
 @ti.func
