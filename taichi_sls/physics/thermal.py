@@ -43,15 +43,14 @@ loses q(T) = h_c (T - T_ch) + eps sigma (T^4 - T_ch^4) per area to the chamber. 
 is exposed over its share of the domain's width (its projected top, the area a rough surface
 presents to the chamber; in 3D each (i, k) column over its share of the bed plane); T is the
 capacity-weighted temperature of the column's top three nodes (the topmost holding material and
-the two below it, fixed ones excluded), and the column's loss
-is taken from them in proportion to their capacities, so the skin cools as one. Over a step the
-skin is one lumped capacity C losing H (T - T_ch), H = A q(T) / (T - T_ch) frozen at the step's
-start, integrated exactly: C (T - T_ch) (1 - exp(-H dt / C)). For H dt / C << 1 that is the flux
-times the area and the step, to O(H dt / C); for a long implicit step on a skin that holds
-little material (a sphere's edge grazing a column by a side wall) it never takes the skin below
-the chamber's temperature, which the flux times the step did. It enters the nodes' heat rate as
-the laser's heat does, and is counted in ``heat_out``: the energy balance still holds to
-round-off.
+the two below it, fixed ones excluded), and the column's loss is taken from them in proportion
+to their capacities, so the skin cools as one. Over a step the skin is one lumped capacity C
+losing H (T - T_ch), with H = A q(T) / (T - T_ch) frozen at the step's start, integrated
+exactly: C (T - T_ch) (1 - exp(-H dt / C)). For H dt / C << 1 that is the flux times the area
+and the step, to O(H dt / C); for a long implicit step on a skin that holds little material (a
+sphere's edge grazing a column by a side wall) it never takes the skin below the chamber's
+temperature, which the flux times the step did. It enters the nodes' heat rate as the laser's
+heat does, and is counted in ``heat_out``: the energy balance still holds to round-off.
 
 Arguments: ``cfg`` the step's configuration, ``pt`` points, ``nd`` nodes, ``mat`` materials,
 ``sc`` the run's scalars (heat out through the walls' nodes), ``lasers`` the beams. The point
