@@ -2,7 +2,7 @@
 key reference. The lowest layer: it imports nothing else of the package."""
 
 from .bed import Bed
-from .bodies import Body, Cylinder, Disc, Polygon, Rect
+from .bodies import Body, Cylinder, Disc, Polygon, Prism, Rect
 from .errors import CaseError
 from .loading import (
     apply_override,
@@ -27,6 +27,7 @@ __all__ = [
     "Disc",
     "Material",
     "Polygon",
+    "Prism",
     "Rect",
     "apply_override",
     "bundled_case",

@@ -1,5 +1,6 @@
-"""Bodies of a case: discs, rectangles and polygons, each seeded with material points, and the
-bodies of a previous layer, whose points are read from its layer file (lengths in um)."""
+"""Bodies of a case: discs, rectangles and polygons (in 3D spheres, cylinders, boxes and
+prisms), each seeded with material points, and the bodies of a previous layer, whose points are
+read from its layer file (lengths in um)."""
 
 from __future__ import annotations
 
@@ -26,7 +27,9 @@ class BodyBase(Model):
 
 
 class Disc(BodyBase):
-    shape: Literal["disc"] = Field("disc", description="disc, cylinder, rect, polygon or points")
+    shape: Literal["disc"] = Field(
+        "disc", description="disc, cylinder, rect, polygon, prism or points"
+    )
     center_um: Point = Field(
         [20.0, 20.0], description="disc centre (um); [x, y] in 2D, [x, y, z] in 3D (a sphere)"
     )
@@ -56,7 +59,7 @@ class Cylinder(BodyBase):
     """3D only: a disc extruded along z across the whole depth (with a periodic depth, an
     infinite cylinder; config/periodic.py)."""
 
-    shape: Literal["cylinder"] = Field(description="disc, cylinder, rect, polygon or points")
+    shape: Literal["cylinder"] = Field(description="disc, cylinder, rect, polygon, prism or points")
     axis_um: Pair = Field(
         [20.0, 20.0],
         description="3D only: the axis' [x, y] (um); a disc extruded along z across the depth",
@@ -72,7 +75,7 @@ class Cylinder(BodyBase):
 
 
 class Rect(BodyBase):
-    shape: Literal["rect"] = Field(description="disc, cylinder, rect, polygon or points")
+    shape: Literal["rect"] = Field(description="disc, cylinder, rect, polygon, prism or points")
     min_um: Point = Field(
         [0.0, 0.0], description="rectangle lower-left corner (um); [x, y, z] in 3D (a box)"
     )
@@ -92,8 +95,9 @@ class Rect(BodyBase):
         return 2 * (a * b + b * c + c * a)
 
 
-class Polygon(BodyBase):
-    shape: Literal["polygon"] = Field(description="disc, cylinder, rect, polygon or points")
+class _Outline(BodyBase):
+    """A closed outline in x-y: a polygon (2D) or the section of a prism (3D)."""
+
     vertices_um: list[Pair] = Field(
         [],
         description="outline vertices [[x, y], ...] (um), in order, either sense; or give "
@@ -133,12 +137,23 @@ class Polygon(BodyBase):
         return sum(math.dist(v[i], v[i - 1]) for i in range(len(v)))
 
 
+class Polygon(_Outline):
+    shape: Literal["polygon"] = Field(description="disc, cylinder, rect, polygon, prism or points")
+
+
+class Prism(_Outline):
+    """3D only: a polygon's outline in x-y extruded along z across the whole depth, as a
+    cylinder extrudes a disc (with a periodic depth, an infinite prism; config/periodic.py)."""
+
+    shape: Literal["prism"] = Field(description="disc, cylinder, rect, polygon, prism or points")
+
+
 class LayerBody(BodyBase):
     """One body of a previous layer: its points as that run left them (positions, volumes, and
     where the file carries them their deformation and stress), placed at rest; the case's
     ``bed.previous_layer`` lists one per body."""
 
-    shape: Literal["points"] = Field(description="disc, cylinder, rect, polygon or points")
+    shape: Literal["points"] = Field(description="disc, cylinder, rect, polygon, prism or points")
     file: str = Field(description="layer file (layer.npz of a bed run), relative to the case file")
     body: int = Field(0, ge=0, description="which body of the layer file")
 
@@ -176,4 +191,6 @@ class LayerBody(BodyBase):
         return 2.0 * math.sqrt(math.pi * float(np.sum(self.points_um()[1])))
 
 
-Body = Annotated[Disc | Cylinder | Rect | Polygon | LayerBody, Field(discriminator="shape")]
+EXTRUDED = ("cylinder", "prism")  # 3D only: a 2D section extruded along z across the depth
+
+Body = Annotated[Disc | Cylinder | Rect | Polygon | Prism | LayerBody, Field(discriminator="shape")]

@@ -114,7 +114,8 @@ def _refuse_in_3d(case: Any) -> None:
         if b.shape == "polygon":
             raise CaseError(
                 f'bodies[{i}].shape = "polygon" with domain.dim = 3: a polygon is a 2D outline; '
-                'allowed in 3D: "disc" (a sphere), "rect" (a box)'
+                'allowed in 3D: "disc" (a sphere), "rect" (a box), "cylinder", "prism" (an '
+                "outline extruded along z)"
             )
         if b.shape == "points":
             raise CaseError(

@@ -1,7 +1,8 @@
 """A periodic depth and the cylinder body (issue #39): ``boundary.front`` and ``boundary.back``
 with ``mechanical = "periodic"`` wrap z with the period ``domain.depth_um`` (solver/periodic.py),
-and a ``shape = "cylinder"`` body is a disc extruded along z across the whole depth. Both are
-3D only; each bad combination is refused by its key."""
+a ``shape = "cylinder"`` body is a disc extruded along z across the whole depth, and a
+``shape = "prism"`` body a polygon's outline extruded so. All are 3D only; each bad combination
+is refused by its key."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ SIDES = ("left", "right", "bottom", "top")
 
 def check_periodic(case: Any) -> None:
     """Refuse a periodic wall other than the front-back pair, a periodic depth in 2D, one of
-    the pair alone, a fixed temperature on it, and a cylinder in 2D."""
+    the pair alone, a fixed temperature on it, and a cylinder or a prism in 2D."""
     b, dim = case.boundary, case.domain.dim
     for key in SIDES:
         if getattr(b, key).mechanical == "periodic":
@@ -55,8 +56,9 @@ def check_periodic(case: Any) -> None:
                 'is not folded over the period; allowed: "usl"'
             )
     for i, body in enumerate(case.bodies):
-        if body.shape == "cylinder" and dim == 2:
+        section = {"cylinder": "disc", "prism": "polygon"}.get(body.shape)
+        if section and dim == 2:
             raise CaseError(
-                f'bodies[{i}].shape = "cylinder" with domain.dim = 2: a cylinder is a disc '
-                'extruded along z, 3D only; allowed in 2D: "disc" (its section)'
+                f'bodies[{i}].shape = "{body.shape}" with domain.dim = 2: a {body.shape} is a '
+                f'{section} extruded along z, 3D only; allowed in 2D: "{section}" (its section)'
             )

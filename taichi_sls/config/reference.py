@@ -9,7 +9,7 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from .bed import Bed
-from .bodies import Cylinder, Disc, LayerBody, Polygon, Rect
+from .bodies import Cylinder, Disc, LayerBody, Polygon, Prism, Rect
 from .materials import CrystallizationKinetics, Material
 from .schema import Case
 from .sections import Boundary, Wall
@@ -22,7 +22,7 @@ def sections() -> list[tuple[str, type[BaseModel]]]:
         if name == "bodies":
             out += [
                 (f'[[bodies]] shape = "{b.model_fields["shape"].annotation.__args__[0]}"', b)
-                for b in (Disc, Cylinder, Rect, Polygon, LayerBody)
+                for b in (Disc, Cylinder, Rect, Polygon, Prism, LayerBody)
             ]
         elif name == "bed":
             out.append(("bed", Bed))

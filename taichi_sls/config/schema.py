@@ -16,7 +16,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from .bed import Bed, bed_discs
 from .bed3d import expand_bed_3d
-from .bodies import Body, Disc, LayerBody
+from .bodies import EXTRUDED, Body, Disc, LayerBody
 from .dim import check_dimension, default_laser_depths, unset_laser_depths
 from .errors import CaseError
 from .layer_file import read_layer
@@ -243,9 +243,9 @@ class Case(Model):
                 raise CaseError(
                     f"{key}.body = {b.body}: the layer file {b.file!r} has no such body"
                 )
-            if b.shape == "polygon" and len(b.outline_um()) < 3:
+            if b.shape in ("polygon", "prism") and len(b.outline_um()) < 3:
                 raise CaseError(
-                    f"{key}.vertices_um: {len(b.outline_um())} vertices; a polygon needs at "
+                    f"{key}.vertices_um: {len(b.outline_um())} vertices; a {b.shape} needs at "
                     "least 3 (or a vertices_file)"
                 )
             lo, hi = b.centres_extent() if b.shape == "points" else b.extent()
@@ -387,10 +387,14 @@ class Case(Model):
 
     def outline_um(self) -> float:
         """The bodies' outline as seeded: their perimeter (um, per unit depth) in 2D, their
-        surface (um^2) in 3D, whose bodies are spheres and boxes."""
+        surface (um^2) in 3D: a sphere's or a box's, and a cylinder's or a prism's side across
+        the depth (extruded, their ends on the front and back walls or the period)."""
         if self.domain.dim == 2:
             return self.perimeter_um()
-        return sum(b.area_um2() for b in self.bodies)
+        depth = self.domain.depth()
+        return sum(
+            b.perimeter_um() * depth if b.shape in EXTRUDED else b.area_um2() for b in self.bodies
+        )
 
     def top_um(self) -> float:
         """The highest point of any body (um): the top of the powder."""

@@ -89,8 +89,8 @@ def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
 def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
     """The body whose inside holds each candidate point (N, 3) (-1: none), the first that
     does: a sphere (a disc with a 3D centre; with a perturbation, its axisymmetric shape mode
-    P_n(cos theta) about x, the 2D mode cos(n theta)'s counterpart) or a box (a rect with 3D
-    corners)."""
+    P_n(cos theta) about x, the 2D mode cos(n theta)'s counterpart), a box (a rect with 3D
+    corners), a cylinder or a prism (a disc or a polygon extruded along z)."""
     owner = np.full(len(P), -1, dtype=np.int64)
     for bi, b in enumerate(case.bodies):
         if b.shape == "disc":
@@ -103,6 +103,8 @@ def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
             inside = r2 < R**2
         elif b.shape == "cylinder":  # a disc extruded along z (config/periodic.py)
             inside = ((P[:, :2] - np.asarray(b.axis_um)) ** 2).sum(axis=1) < b.radius_um**2
+        elif b.shape == "prism":  # a polygon extruded along z
+            inside = inside_polygon(np.asarray(b.outline_um(), dtype=float), P[:, 0], P[:, 1])
         else:
             inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
         owner[(owner == -1) & inside] = bi

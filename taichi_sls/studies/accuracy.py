@@ -170,6 +170,30 @@ STUDIES = (
         case="hopper3d",
         on_request=True,
     ),
+    Study(  # from Hopper's outline at tau0 = 0.5 (a prism), as the 2D turned row starts
+        "hopper3d_shape_r20",
+        (20,),
+        (20,),
+        "neck_tau1",
+        sets={"verification": {"hopper_taus": [0.5, 1.0, 2.0], "hopper_tau0": 0.5}},
+        case="hopper3d",
+        on_request=True,
+    ),
+    Study(  # the same outline turned by 45 deg in the plane
+        "hopper3d_shape_45deg_r20",
+        (20,),
+        (20,),
+        "neck_tau1",
+        sets={
+            "verification": {
+                "hopper_taus": [0.5, 1.0, 2.0],
+                "hopper_tau0": 0.5,
+                "hopper_angle_deg": 45.0,
+            }
+        },
+        case="hopper3d",
+        on_request=True,
+    ),
 )
 
 

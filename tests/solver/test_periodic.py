@@ -97,6 +97,13 @@ def _case(**over) -> dict:
             },
             'bodies[0].shape = "cylinder" with domain.dim = 2',
         ),
+        (
+            {
+                "domain": {"width_um": 12.0, "height_um": 12.0},
+                "bodies": [{"shape": "prism", "vertices_um": [[3, 3], [9, 3], [6, 9]]}],
+            },
+            'bodies[0].shape = "prism" with domain.dim = 2',
+        ),
         (_case(boundary={"front": {"mechanical": "periodic"}}), "boundary.back.mechanical"),
         (_case(boundary={"left": {"mechanical": "periodic"}}), "boundary.left.mechanical"),
         (
@@ -129,6 +136,35 @@ def test_a_cylinder_runs_across_the_depth():
     assert len(layers) == 8  # two point layers per cell
     count = [(np.abs(x[:, 2] - z) < 1e-6).sum() for z in layers]
     assert len(set(count)) == 1
+
+
+def test_a_prism_is_the_polygon_in_every_layer():
+    """A prism (a triangle's outline extruded along z, 4 um deep) seeds in each of its 8 z
+    layers of points exactly the x-y points the 2D polygon seeds (same grid, same centre
+    seeding); its outline for the energy scales is the triangle's perimeter times the depth,
+    as a cylinder's is 2 pi R times it."""
+    tri = [[3.0, 3.0], [9.0, 3.5], [5.0, 9.0]]
+    d2 = _case(bodies=[{"shape": "polygon", "vertices_um": tri, "material": "fluid"}])
+    d2["domain"] = {"width_um": 12.0, "height_um": 12.0}
+    d2["boundary"] = OPEN
+    d2["physics"]["gravity_m_s2"] = [0.0, 0.0]
+    d3 = _case(bodies=[{"shape": "prism", "vertices_um": tri, "material": "fluid"}])
+    d3["domain"] = {"dim": 3, "width_um": 12.0, "height_um": 12.0, "depth_um": 4.0}
+    flat, prism = build_scene(make_case(d2)), build_scene(make_case(d3))
+    xy = np.round(np.sort(flat.x[:, 0] * 1e6 + 1e3 * flat.x[:, 1] * 1e6), 9)
+    layers = np.unique(np.round(prism.x[:, 2] * 1e6, 6))
+    assert len(layers) == 8
+    for z in layers:
+        sel = np.abs(prism.x[:, 2] * 1e6 - z) < 1e-6
+        layer = np.round(np.sort(prism.x[sel, 0] * 1e6 + 1e3 * prism.x[sel, 1] * 1e6), 9)
+        np.testing.assert_array_equal(layer, xy)
+    perimeter = float(np.sum(np.linalg.norm(np.diff(np.array(tri + tri[:1]), axis=0), axis=1)))
+    assert make_case(d3).outline_um() == pytest.approx(perimeter * 4.0, rel=1e-12)
+    cyl = _case(
+        bodies=[{"shape": "cylinder", "axis_um": [6, 6], "radius_um": 3.0, "material": "fluid"}]
+    )
+    cyl["domain"] = d3["domain"]
+    assert make_case(cyl).outline_um() == pytest.approx(2 * np.pi * 3.0 * 4.0, rel=1e-12)
 
 
 def _heat_run(hot, cold):

@@ -56,3 +56,23 @@ def test_turned_pair_follows_hopper_at_R0_h_20():
     for k in ("neck_tau0.5", "neck_tau1", "neck_tau2", "neck_tau3"):
         assert abs(r.errors[k]) < 0.03, r.errors
     assert abs(r.errors["area"]) < 0.005
+
+
+def test_3d_pair_from_the_outline_is_the_2d_polygon_extruded():
+    """hopper3d from tau0 = 0.5 turned by 45 deg: one prism along the periodic depth whose
+    outline, frame and seeded section are the 2D polygon's (hopper_shape at the same R0/h and
+    angle): the 3D points' volume over the depth equals the 2D points' area (to round-off,
+    1e-12: every z layer seeds the polygon's points)."""
+    from taichi_sls.solver.scene import build_scene
+
+    sets = {"verification": {"hopper_tau0": 0.5, "hopper_angle_deg": 45.0}}
+    flat = ver.load("hopper_shape", 10, sets).case
+    deep = ver.load("hopper3d", 10, sets).case
+    assert [b.shape for b in deep.bodies] == ["prism"] and deep.domain.dim == 3
+    assert deep.boundary.front.mechanical == "periodic"
+    np.testing.assert_allclose(deep.bodies[0].outline_um(), flat.bodies[0].outline_um())
+    (R2, c2, t2), (R3, c3, t3) = hopper_frame(flat), hopper_frame(deep)
+    assert (R3, t3) == (R2, t2) and np.array_equal(c3, c2)
+    area = build_scene(flat).vol.sum()
+    volume = build_scene(deep).vol.sum()
+    assert volume / (deep.domain.depth_um * 1e-6) == pytest.approx(area, rel=1e-12)

@@ -50,9 +50,10 @@ def hopper_radius_um(data: dict) -> float:
     b = data["bodies"][0]
     if b.get("shape", "disc") in ("disc", "cylinder"):
         return float(b["radius_um"])
-    from ...config import Polygon
+    from ...config import Polygon, Prism
 
-    v = np.asarray(Polygon(**{k: b[k] for k in b if k != "material"}).outline_um(), dtype=float)
+    outline = Prism if b.get("shape") == "prism" else Polygon
+    v = np.asarray(outline(**{k: b[k] for k in b if k != "material"}).outline_um(), dtype=float)
     # rounded to 1 nm: the polygon's area falls short of the outline's by ~5e-5
     return round(math.sqrt(abs(ref.polygon_area(v)) / (2.0 * math.pi)), 3)
 
@@ -72,8 +73,9 @@ def hopper_geometry(data: dict, R0_over_h: float) -> None:
     turned pair), the mid-plane on a node line or through cell centres
     (verification.hopper_midplane), the line of centres 0.377 h off the node rows and turned by
     hopper_angle_deg about the neck. tau0 = 0: two touching discs; tau0 > 0: the outline at tau0
-    as a polygon of 1024 vertices. A 3D case (cases/verification/hopper3d.toml): two touching
-    cylinders along a periodic depth of the file's cells, the same pair in every x-y section."""
+    as a polygon of 1024 vertices. A 3D case (cases/verification/hopper3d.toml): the same pair
+    along a periodic depth of the file's cells, in every x-y section (two touching cylinders, or
+    the outline as a prism)."""
     v = data.setdefault("verification", {})
     R0 = hopper_radius_um(data)
     h = R0 / R0_over_h
@@ -87,15 +89,9 @@ def hopper_geometry(data: dict, R0_over_h: float) -> None:
     data["grid"]["spacing_um"] = h
     data["domain"] = {"width_um": W, "height_um": H}
     mat = data["bodies"][0].get("material", "PA12")
-    if depth_cells:  # 3D: two cylinders along a periodic depth of as many cells as the file's
-        data["domain"].update(dim=3, depth_um=depth_cells * h)
-        dx, dy = R0 * math.cos(turn), R0 * math.sin(turn)
-        data["bodies"] = [
-            {"shape": "cylinder", "axis_um": [X - dx, Y - dy], "radius_um": R0, "material": mat},
-            {"shape": "cylinder", "axis_um": [X + dx, Y + dy], "radius_um": R0, "material": mat},
-        ]
-        return
     tau0 = float(v.get("hopper_tau0", 0.0))
+    if depth_cells:  # 3D: the pair along a periodic depth of as many cells as the file's
+        data["domain"].update(dim=3, depth_um=depth_cells * h)
     if tau0 > 0.0:
         outline = ref.hopper_outline(ref.hopper_nu(tau0), R0, 1024, (0.0, 0.0))
         c, s = math.cos(turn), math.sin(turn)
@@ -110,10 +106,12 @@ def hopper_geometry(data: dict, R0_over_h: float) -> None:
             if turn != 0.0
             else outline + np.array([X, Y])
         )
-        data["bodies"] = [{"shape": "polygon", "vertices_um": xy.tolist(), "material": mat}]
-    else:
+        shape = "prism" if depth_cells else "polygon"
+        data["bodies"] = [{"shape": shape, "vertices_um": xy.tolist(), "material": mat}]
+    else:  # two touching discs, in 3D two cylinders
+        shape, key = ("cylinder", "axis_um") if depth_cells else ("disc", "center_um")
         dx, dy = R0 * math.cos(turn), R0 * math.sin(turn)
         data["bodies"] = [
-            {"shape": "disc", "center_um": [X - dx, Y - dy], "radius_um": R0, "material": mat},
-            {"shape": "disc", "center_um": [X + dx, Y + dy], "radius_um": R0, "material": mat},
+            {"shape": shape, key: [X + sign * dx, Y + sign * dy], "radius_um": R0, "material": mat}
+            for sign in (-1.0, 1.0)
         ]
