@@ -15,6 +15,7 @@ from .bed import Bed, bed_diameters, check_csv_rows, read_columns
 from .bodies import Disc
 from .deposition3d import deposit_spheres
 from .errors import CaseError
+from .layer_file import read_layer
 from .packing3d import packing_fractions_3d
 
 MAX_SPHERES = 20_000  # the generator takes about a minute at this count
@@ -22,10 +23,12 @@ FCC = math.pi / (3 * math.sqrt(2))  # densest packing of spheres: no bed can exc
 COLUMNS = ("x_um", "y_um", "z_um", "radius_um")
 
 
-def expand_bed_3d(case: Any) -> None:
+def expand_bed_3d(case: Any, below: list | None = None) -> None:
     """Replace ``case.bed`` by its spheres, appended to ``case.bodies`` (the resolved case lists
     them and loads back to the same bed); an unset domain width, height or depth is fitted to
-    the bed (its x and z ranges; its top plus one mean diameter), in whole cells."""
+    the bed (its x and z ranges; its top plus one mean diameter), in whole cells. ``below``: the
+    bodies of ``bed.previous_layer`` (LayerBody), listed before the new spheres, which land on
+    its points (each a sphere in its cube, as 2D's discs land on squares)."""
     bed: Bed = case.bed
     if bed.material not in case.materials:
         raise CaseError(
@@ -41,7 +44,19 @@ def expand_bed_3d(case: Any) -> None:
     # without depth_um the domain is as deep as it is wide (Domain.depth)
     size[2] = case.domain.depth_um if case.domain.depth_um is not None else size[0]
     old = [[*b.center_um, b.radius_um] for b in case.bodies if b.shape == "disc"]
-    c, r, report = bed_spheres(bed, np.array(old, float).reshape(-1, 4), *size)
+    floor = None
+    if below:
+        layer = read_layer(bed.previous_layer)
+        floor = np.column_stack([layer.x_um, 0.5 * layer.spacing_um()])
+    c, r, report = bed_spheres(bed, np.array(old, float).reshape(-1, 4), *size, floor=floor)
+    if below:  # the generator's fractions would count the layer below as void
+        report.update(
+            envelope=math.nan,
+            bulk=math.nan,
+            previous_layer=Path(bed.previous_layer).name,
+            previous_layer_bodies=len(below),
+            previous_layer_points=len(layer.volume),
+        )
     h = case.grid.spacing_um
     fit = [
         max(report["x_range_um"][1], float(np.max(c[:, 0] + r))),
@@ -53,6 +68,7 @@ def expand_bed_3d(case: Any) -> None:
             setattr(case.domain, key, h * math.ceil(f / h - 1e-9))
     case.bodies = [
         *case.bodies,
+        *(below or []),
         *(
             Disc(
                 center_um=[float(v) for v in ci],
@@ -101,11 +117,21 @@ def _ranges(bed: Bed, width, depth, csv: np.ndarray) -> list[tuple[float, float]
 
 
 def bed_spheres(
-    bed: Bed, old: np.ndarray, width: float | None, height: float | None, depth: float | None
+    bed: Bed,
+    old: np.ndarray,
+    width: float | None,
+    height: float | None,
+    depth: float | None,
+    floor: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, dict]:
     """The bed's spheres (centres (n, 3), radii; um) and the case report: the CSV's, checked,
     then the generated ones on top of them and of the earlier sphere bodies ``old`` (rows x, y,
-    z, r). width, height, depth: the domain they must fit (None: sized to the bed)."""
+    z, r). width, height, depth: the domain they must fit (None: sized to the bed). ``floor``:
+    a previous layer's points as spheres (rows x, y, z, r), landed on like ``old`` but left out
+    of the contact count (its points touch each other)."""
+    bodies = old
+    if floor is not None:
+        old = np.concatenate([old, floor])
     if bed.csv is None and bed.count is None and bed.layers is None:
         raise CaseError("bed: no spheres; give bed.count or bed.layers (generate), or bed.csv")
     if bed.count is not None and bed.layers is not None:
@@ -155,7 +181,9 @@ def bed_spheres(
         "source": " + ".join(source),
         "x_range_um": [x0, x1],
         "z_range_um": [z0, z1],
-        "contacts": _contacts(np.concatenate([c, old[:, :3]]), np.concatenate([r, old[:, 3]])),
+        "contacts": _contacts(
+            np.concatenate([c, bodies[:, :3]]), np.concatenate([r, bodies[:, 3]])
+        ),
         **frac,
     }
     return c, r, report

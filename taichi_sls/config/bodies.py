@@ -165,30 +165,35 @@ class LayerBody(BodyBase):
         return v
 
     def points_um(self) -> tuple[np.ndarray, np.ndarray]:
-        """(positions (n, 2), volumes (n,)) of the body's points (um, um^2)."""
+        """(positions (n, dim), volumes (n,)) of the body's points (um, um^dim)."""
         return read_layer(self.file, "bodies[].file").of_body(self.body)
 
-    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+    def extent(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         x, vol = self.points_um()
-        half = 0.5 * np.sqrt(vol)
+        half = 0.5 * vol ** (1.0 / x.shape[1])
         lo, hi = (x - half[:, None]).min(axis=0), (x + half[:, None]).max(axis=0)
-        return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
+        return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
 
     def carried_state(self) -> tuple[np.ndarray, dict[str, np.ndarray]] | None:
         """(seeded volumes (um^2), the points' deformation and stress members) as the layer's
         run left them, or None where the file does not carry them (config/layer_file.py)."""
         return read_layer(self.file, "bodies[].file").state_of_body(self.body)
 
-    def centres_extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+    def centres_extent(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """The box of the points themselves (their squares may reach a hair into a wall that
         the run pressed them against)."""
         x, _ = self.points_um()
         lo, hi = x.min(axis=0), x.max(axis=0)
-        return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
+        return tuple(float(v) for v in lo), tuple(float(v) for v in hi)
 
     def perimeter_um(self) -> float:
         """The perimeter of the circle of the body's area (a lower bound of its outline)."""
         return 2.0 * math.sqrt(math.pi * float(np.sum(self.points_um()[1])))
+
+    def area_um2(self) -> float:
+        """3D: the surface of the sphere of the body's volume (a lower bound of its outline)."""
+        volume = float(np.sum(self.points_um()[1]))
+        return (36.0 * math.pi * volume**2) ** (1.0 / 3.0)
 
 
 EXTRUDED = ("cylinder", "prism")  # 3D only: a 2D section extruded along z across the depth

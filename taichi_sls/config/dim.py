@@ -117,20 +117,10 @@ def _refuse_in_3d(case: Any) -> None:
                 'allowed in 3D: "disc" (a sphere), "rect" (a box), "cylinder", "prism" (an '
                 "outline extruded along z)"
             )
-        if b.shape == "points":
-            raise CaseError(
-                f'bodies[{i}].shape = "points" with domain.dim = 3: layer files are {not_yet}; '
-                'allowed in 3D: "disc" (a sphere), "rect" (a box)'
-            )
     if case.grid.seeding == "area":
         raise CaseError(
             f'grid.seeding = "area" with domain.dim = 3: area seeding is {not_yet}; allowed in '
             '3D: "centre"'
-        )
-    if case.bed is not None and case.bed.previous_layer is not None:
-        raise CaseError(
-            f"bed.previous_layer = {case.bed.previous_layer!r} with domain.dim = 3: layer files "
-            f"are {not_yet}; allowed in 3D: a generated bed or bed.csv of spheres"
         )
     if case.solver.layout == "blocks":
         raise CaseError(

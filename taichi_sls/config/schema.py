@@ -93,7 +93,7 @@ class Case(Model):
         if bed is None:
             return
         if self.domain.dim == 3:
-            expand_bed_3d(self)
+            expand_bed_3d(self, self._previous_layer(bed))
             return
         if bed.material not in self.materials:
             raise CaseError(
@@ -117,7 +117,7 @@ class Case(Model):
                 bulk=math.nan,
                 previous_layer=Path(bed.previous_layer).name,
                 previous_layer_bodies=len(below),
-                previous_layer_points=len(layer.volume_um2),
+                previous_layer_points=len(layer.volume),
             )
         h = self.grid.spacing_um
         if W is None:
@@ -149,6 +149,11 @@ class Case(Model):
             return []
         layer = read_layer(bed.previous_layer)
         key = f"bed.previous_layer = {bed.previous_layer!r}"
+        if layer.dim != self.domain.dim:
+            raise CaseError(
+                f"{key}: a {layer.dim}D layer (x_um with {layer.dim} columns) with domain.dim = "
+                f"{self.domain.dim}; allowed: a layer file written by a {self.domain.dim}D run"
+            )
         spacing = self.grid.spacing_um / self.grid.points_per_cell
         seeded = float(np.median(layer.spacing_um()))  # most are whole points
         if not 0.8 * spacing <= seeded <= 1.25 * spacing:
@@ -239,6 +244,12 @@ class Case(Model):
             rect = b.shape == "rect"
             if rect and not all(c > a for a, c in zip(b.min_um, b.max_um, strict=True)):
                 raise CaseError(f"{key}.max_um = {b.max_um}: must exceed min_um = {b.min_um}")
+            if b.shape == "points" and read_layer(b.file).dim != self.domain.dim:
+                raise CaseError(
+                    f"{key}.file = {b.file!r}: a {read_layer(b.file).dim}D layer with "
+                    f"domain.dim = {self.domain.dim}; allowed: a layer file written by a "
+                    f"{self.domain.dim}D run"
+                )
             if b.shape == "points" and len(b.points_um()[1]) == 0:
                 raise CaseError(
                     f"{key}.body = {b.body}: the layer file {b.file!r} has no such body"

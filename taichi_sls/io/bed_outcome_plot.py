@@ -44,11 +44,17 @@ def plot_bed_outcome(
     time_molten: np.ndarray | None = None,
     density: tuple[float, float] | None = None,
     neck_growth: float | None = None,
+    spacing_um: float | None = None,
     dpi: int = 90,
 ) -> Path | None:
     """Draw :func:`bed_outcome_figure` to OUT/outcome.png; None without contacts."""
     fig = bed_outcome_figure(
-        rows, x_um, time_molten=time_molten, density=density, neck_growth=neck_growth
+        rows,
+        x_um,
+        time_molten=time_molten,
+        density=density,
+        neck_growth=neck_growth,
+        spacing_um=spacing_um,
     )
     if fig is None:
         return None
@@ -64,11 +70,14 @@ def bed_outcome_figure(
     time_molten: np.ndarray | None = None,
     density: tuple[float, float] | None = None,
     neck_growth: float | None = None,
+    spacing_um: float | None = None,
 ) -> Figure | None:
     """The bed's outcome from the contacts table's rows, the points' final positions (um) and,
     when given, their time above T_m (s; the melted powder tinted), the layer's relative
     density (start, end) and the fusion rule's neck growth (its line on the growth panel).
-    None without contacts."""
+    ``spacing_um``: the points' spacing for the map's raster (default: read from the points;
+    a 3D run's projection onto x-y gives it, since its points lie on each other to round-off
+    until they move). None without contacts."""
     if not rows:
         return None
     fig = Figure(figsize=(13, 6.8), layout="constrained")
@@ -77,7 +86,7 @@ def bed_outcome_figure(
     ax_map = fig.add_subplot(grid[0, :])
     ax_hist, ax_growth = fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1])
     kinds = [contact_kind(r) for r in rows]
-    _draw_map(ax_map, rows, kinds, np.asarray(x_um, dtype=float), time_molten)
+    _draw_map(ax_map, rows, kinds, np.asarray(x_um, dtype=float), time_molten, spacing_um)
     n, fused = len(rows), kinds.count("fused")
     title = f"the layer at the end: {n} contacts, {fused} fused ({fused / n:.0%})"
     if density is not None and all(np.isfinite(density)):
@@ -94,6 +103,7 @@ def _draw_map(
     kinds: list[str],
     x: np.ndarray,
     time_molten: np.ndarray | None,
+    spacing_um: float | None = None,
 ) -> None:
     """The final material filled (melted powder tinted) and each contact where it started,
     coloured by its outcome."""
@@ -101,7 +111,7 @@ def _draw_map(
     x = x[ok]
     if len(x):
         lo, hi = x.min(axis=0), x.max(axis=0)
-        spacing = point_spacing(x, float((hi - lo).max()) / 100)
+        spacing = spacing_um or point_spacing(x, float((hi - lo).max()) / 100)
         pixel = spacing / PIXELS_PER_SPACING
         corner = lo - 4 * spacing
         nx, ny = (np.ceil((hi + 4 * spacing - corner) / pixel)).astype(int)

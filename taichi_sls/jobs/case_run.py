@@ -285,9 +285,12 @@ def run_case(
                     time_molten=arrays["time_molten"],
                     density=(density["initial"], density["final"]),
                     neck_growth=case.fusion.neck_growth,
+                    spacing_um=case.grid.spacing_um / case.grid.points_per_cell
+                    if case.domain.dim == 3
+                    else None,
                 )
-                # the layer a next one is deposited on (layer files are 2D)
-                if summary["status"] != "failed" and case.domain.dim == 2:
+                # the layer a next one is deposited on
+                if summary["status"] != "failed":
                     write_layer_file(out_dir / LAYER_FILE, sim, summary["status"])
                     summary["layer_file"] = LAYER_FILE
             except Exception as e:  # noqa: BLE001 -- never cost the run's other outputs
@@ -348,16 +351,17 @@ def write_layer_file(path: Path, sim: Simulation, status: str) -> None:
     """The points as they are now, for a case that deposits a layer on them (bed.previous_layer)."""
     carried = (*CARRIED_STATE, *OPTIONAL_STATE)
     pt, sc = sim.point_arrays(("x", "volume0", "J", "T", *carried)), sim.scene
+    dim = sim.state.cfg.dim
     write_layer(
         path,
         x_um=pt["x"] * 1e6,
-        volume_um2=pt["volume0"] * pt["J"] * 1e12,
+        volume=pt["volume0"] * pt["J"] * 1e6**dim,
         body=sc.body,
         material=sc.material,
         material_names=sc.material_names,
         T_C=pt["T"] - KELVIN,
         info={"case": sim.case.case.name, "t_s": sim.t, "status": status},
-        volume0_um2=pt["volume0"] * 1e12,
+        volume0=pt["volume0"] * 1e6**dim,
         state={k: pt[k] for k in carried},
     )
 

@@ -86,13 +86,19 @@ def _inside(body, px: np.ndarray, py: np.ndarray) -> np.ndarray:
     return (px > x0) & (px < x1) & (py > y0) & (py < y1)
 
 
-def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
+def _owners_3d(case: Case, P: np.ndarray, spacing: float) -> np.ndarray:
     """The body whose inside holds each candidate point (N, 3) (-1: none), the first that
     does: a sphere (a disc with a 3D centre; with a perturbation, its axisymmetric shape mode
     P_n(cos theta) about x, the 2D mode cos(n theta)'s counterpart), a box (a rect with 3D
-    corners), a cylinder or a prism (a disc or a polygon extruded along z)."""
+    corners), a cylinder or a prism (a disc or a polygon extruded along z); none within a
+    previous layer point's cube, and with fillets the bridges to that layer (as in 2D)."""
     owner = np.full(len(P), -1, dtype=np.int64)
+    layer = LayerPoints.of_case(case)
+    taken = layer.covers(P, 0.5 * spacing)
+    owner[taken] = -2
     for bi, b in enumerate(case.bodies):
+        if b.shape == "points":  # a previous layer's points are placed, not seeded
+            continue
         if b.shape == "disc":
             d = P - np.asarray(b.center_um)
             r2 = (d**2).sum(axis=1)
@@ -109,7 +115,10 @@ def _owners_3d(case: Case, P: np.ndarray) -> np.ndarray:
             inside = ((P > np.asarray(b.min_um)) & (P < np.asarray(b.max_um))).all(axis=1)
         owner[(owner == -1) & inside] = bi
     if case.contact.initial == "fillet":
+        if len(layer):
+            layer_bridges(case, layer, P, owner, spacing)
         _sphere_bridges(case, P, owner)
+    owner[taken] = -1
     return owner
 
 
@@ -147,7 +156,8 @@ def _owners(case: Case, px: np.ndarray, py: np.ndarray, spacing: float) -> np.nd
     is seeded within a previous layer point's cell (its points are its own)."""
     owner = np.full(px.shape, -1, dtype=np.int64)
     layer = LayerPoints.of_case(case)
-    taken = layer.covers(px, py, 0.5 * spacing)
+    P = np.stack([px, py], axis=-1)
+    taken = layer.covers(P, 0.5 * spacing)
     owner[taken] = -2
     for bi, b in enumerate(case.bodies):
         owner[(owner == -1) & _inside(b, px, py)] = bi
@@ -155,7 +165,7 @@ def _owners(case: Case, px: np.ndarray, py: np.ndarray, spacing: float) -> np.nd
         owner[taken] = -1
         return owner
     if len(layer):
-        layer_bridges(case, layer, px, py, owner, spacing)
+        layer_bridges(case, layer, P, owner, spacing)
     rho = case.contact.fillet_radius_um
     discs = [(i, b) for i, b in enumerate(case.bodies) if b.shape == "disc" and not b.perturbation]
     for k, (ia, a) in enumerate(discs):
@@ -235,7 +245,7 @@ def build_scene(case: Case) -> Scene:
     if dim == 2:
         owner, fill = _seed(case, *P, h_um / n)
     else:  # centre seeding (config/dim.py refuses area seeding in 3D)
-        owner = _owners_3d(case, np.stack(P, axis=1))
+        owner = _owners_3d(case, np.stack(P, axis=1), h_um / n)
         fill = np.ones(len(owner))
     for bi, b in enumerate(case.bodies):
         sel = owner == bi
@@ -246,7 +256,7 @@ def build_scene(case: Case) -> Scene:
             if state is not None:  # the volumes they were seeded with, deformed by their F
                 vol = state[0]
                 carried.append((sum(len(a) for a in fills), state[1]))
-            xy, f = np.concatenate([placed, xy]), np.concatenate([vol / (h_um / n) ** 2, f])
+            xy, f = np.concatenate([placed, xy]), np.concatenate([vol / (h_um / n) ** dim, f])
         k = len(f)
         xs.append(xy)
         fills.append(f)

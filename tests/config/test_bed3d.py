@@ -208,11 +208,13 @@ def test_bad_csv_spheres_are_one_line_errors(tmp_path, rows, says):
     assert msg.startswith(f"bed.csv = {str(path)!r}") and says in msg
 
 
-def test_3d_bed_refusals_name_their_keys(tmp_path):
-    layer = tmp_path / "layer.npz"
-    layer.write_bytes(b"")
+def test_3d_bed_refusals_name_their_keys():
+    from taichi_sls.config import bundled_case
+
+    layer = bundled_case("machine_layer").parent / "layers" / "machine_layer.npz"  # a 2D layer
     msg = _error({"previous_layer": str(layer), "count": 3})
-    assert msg.startswith("bed.previous_layer =") and "domain.dim = 3" in msg
+    assert msg.startswith("bed.previous_layer =") and "a 2D layer" in msg
+    assert "domain.dim = 3" in msg
     msg = _error(
         {"count": 900, "median_diameter_um": 20.0, "x_range_um": [0, 60]},
         domain={"dim": 3, "width_um": 60.0, "height_um": 40.0, "depth_um": 60.0},

@@ -24,7 +24,7 @@ def _slab(path, width=120.0, height=30.0, spacing=2.0, bodies=3, material="PA12"
     write_layer(
         path,
         x_um=x,
-        volume_um2=np.full(len(x), spacing**2),
+        volume=np.full(len(x), spacing**2),
         body=body,
         material=np.zeros(len(x), dtype=int),
         material_names=[material],
@@ -82,7 +82,7 @@ def test_the_scene_holds_the_layer_points_as_they_were(tmp_path):
     mine = sc.body < 3
     placed = np.isin(np.round(sc.x[mine] * 1e6, 9).view("f8,f8"), np.round(x, 9).view("f8,f8"))
     assert placed.sum() == len(x)
-    assert np.isclose(sc.vol[mine][placed.ravel()].sum() * 1e12, layer.volume_um2.sum())
+    assert np.isclose(sc.vol[mine][placed.ravel()].sum() * 1e12, layer.volume.sum())
     from scipy.spatial import cKDTree
 
     d, _ = cKDTree(x).query(sc.x[~mine] * 1e6, p=np.inf)

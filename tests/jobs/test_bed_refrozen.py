@@ -146,7 +146,7 @@ def test_the_refrozen_layer_is_the_base_of_a_second(refrozen, tmp_path):
     assert d.max() < 1e-12  # every layer point placed where it refroze
     rho = case.materials["PA12"].density_kg_m3
     mass = sim.state.points.mass.to_numpy()[mine].sum()
-    placed = rho * layer.volume0_um2.sum() * 1e-12  # the first run's mass
+    placed = rho * layer.volume0.sum() * 1e-12  # the first run's mass
     assert placed <= mass < 1.03 * placed  # plus its share of the new fillets
     result = run_case(second, tmp_path / "second", progress=False)
     nl = result["bed"]["new_layer"]
@@ -170,7 +170,7 @@ def test_the_layer_restarts_at_rest_with_its_stress(refrozen, tmp_path):
     write_layer(
         bare,
         x_um=layer.x_um,
-        volume_um2=layer.volume_um2,
+        volume=layer.volume,
         body=layer.body,
         material=layer.material,
         material_names=list(layer.material_names),

@@ -6,6 +6,7 @@ it. A file without the fraction (written before it was carried) restarts every p
 phase of its temperature."""
 
 import numpy as np
+import pytest
 from helpers import make_case
 
 from taichi_sls.config.layer_file import read_layer
@@ -87,3 +88,57 @@ def test_a_file_without_the_fraction_restarts_at_the_phase_of_its_temperature(tm
     np.savez_compressed(path, **kept)
     layer, _ = _second(path)
     assert (layer["solid_fraction"] == 1.0).all()
+
+
+@pytest.mark.slow  # two 3D simulations built: 30 s beside other runs
+def test_a_3d_layer_round_trip_carries_its_points_and_state(tmp_path):
+    """3D: a sphere on the plate, its left half molten and its points' deformation set to a
+    shear, written as a layer file (x (N, 3), um^3), read by a 3D bed of two spheres: the
+    layer's points restart where they were, with their seeded volumes, deformation gradient
+    (float32 in the file: 1e-7) and solid fraction, at the bed temperature."""
+    case = make_case(
+        {
+            "grid": {"spacing_um": 4.0},
+            "domain": {"dim": 3, "width_um": 40.0, "height_um": 40.0, "depth_um": 40.0},
+            "bodies": [{"shape": "disc", "center_um": [20.0, 10.0, 20.0], "radius_um": 10.0}],
+            "materials": PROCESS,
+            "thermal": {"initial_C": BED_C},
+            "physics": {"gravity_m_s2": [0.0, 0.0, 0.0]},
+            "output": {"png": False, "gif": False},
+        }
+    )
+    sim = Simulation(case)
+    pts = sim.point_arrays(("x", "volume0", "solid_fraction", "F"))
+    xi = np.where(pts["x"][:, 0] < 20e-6, 0.0, pts["solid_fraction"])
+    F = pts["F"].copy()
+    F[:, 0, 1] = 0.01  # a shear the next run must find again
+    struct_copy.from_numpy(sim.state.points, {"solid_fraction": xi, "F": F})
+    path = tmp_path / "layer.npz"
+    write_layer_file(path, sim, "complete")
+    layer = read_layer(str(path))
+    assert layer.dim == 3 and layer.x_um.shape == (len(xi), 3)
+    second = make_case(
+        {
+            "grid": {"spacing_um": 4.0},
+            "domain": {"dim": 3, "width_um": 40.0, "depth_um": 40.0},
+            "bed": {
+                "previous_layer": str(path),
+                "count": 2,
+                "median_diameter_um": 12.0,
+                "seed": 1,
+            },
+            "materials": PROCESS,
+            "thermal": {"initial_C": BED_C},
+            "physics": {"gravity_m_s2": [0.0, 0.0, 0.0]},
+            "output": {"png": False, "gif": False},
+        }
+    )
+    assert [b.shape for b in second.bodies] == ["points", "disc", "disc"]
+    again = Simulation(second)
+    n = len(xi)
+    got = again.point_arrays(("x", "volume0", "solid_fraction", "F", "T"))
+    assert np.allclose(got["x"][:n], pts["x"], rtol=0, atol=1e-15)
+    assert np.allclose(got["volume0"][:n], pts["volume0"], rtol=1e-12, atol=0)
+    assert np.allclose(got["F"][:n], F, rtol=0, atol=1e-7)
+    assert np.array_equal(got["solid_fraction"][:n], xi)
+    assert np.allclose(got["T"][:n] - 273.15, BED_C)

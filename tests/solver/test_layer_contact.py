@@ -34,9 +34,10 @@ def _bridge(spacing: float):
     px, py = (a.ravel() for a in np.meshgrid(u, v, indexing="ij"))
     in_b = np.hypot(px - B[0], py - B[1]) < R
     owner = np.where(in_b, 1, -1)
-    in_layer = layer.covers(px, py)
+    P = np.stack([px, py], axis=-1)
+    in_layer = layer.covers(P)
     owner[in_layer] = -2
-    layer_bridges(case, layer, px, py, owner, spacing)
+    layer_bridges(case, layer, P, owner, spacing)
     got = (owner >= 0) & ~in_b & ~in_layer
     outside = (np.hypot(px - A[0], py - A[1]) >= R) & ~in_b
     exact = in_bridge(fillet(A, R, B, R, RHO), A, B, px, py) & outside
