@@ -136,3 +136,27 @@ def test_a_layer_of_the_other_dimension_is_refused(tmp_path, dim):
     msg = str(err.value)
     assert msg.startswith("bed.previous_layer =") and "\n" not in msg
     assert f"a {5 - dim}D layer" in msg and f"domain.dim = {dim}" in msg
+
+
+def test_bundled_3d_second_layer_loads_and_round_trips(tmp_path):
+    """cases/machine_layer2_3d.toml: machine_layer3d's layer at the end of its layer time
+    (bundled layers/machine_layer3d.npz, 3D, carried with its solid fraction: most of the thin
+    layer is still melt at 172 C) under 48 new spheres that reach above it; the resolved case
+    (the layer's bodies listed as points bodies) loads back to the same bodies."""
+    from taichi_sls.config import bundled_case, case_to_toml, load_case
+    from taichi_sls.config.loading import bundled_root
+
+    case = load_case(bundled_case("machine_layer2_3d"))
+    shapes = [b.shape for b in case.bodies]
+    n_below = shapes.count("points")
+    assert n_below > 0 and shapes.count("disc") == 48
+    below_top = max(b.extent()[1][1] for b in case.bodies[:n_below])
+    new_top = max(b.extent()[1][1] for b in case.bodies[n_below:])
+    assert new_top > below_top + 10.0  # at least half a sphere higher
+    layer = read_layer(bundled_root() / "layers" / "machine_layer3d.npz")
+    assert layer.dim == 3 and layer.state is not None
+    assert np.mean(np.asarray(layer.state["solid_fraction"]) < 0.5) > 0.5  # mostly melt
+    path = tmp_path / "case.toml"
+    path.write_text(case_to_toml(case))
+    again = load_case(path)
+    assert [b.model_dump() for b in again.bodies] == [b.model_dump() for b in case.bodies]
