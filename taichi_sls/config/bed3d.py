@@ -44,19 +44,11 @@ def expand_bed_3d(case: Any, below: list | None = None) -> None:
     # without depth_um the domain is as deep as it is wide (Domain.depth)
     size[2] = case.domain.depth_um if case.domain.depth_um is not None else size[0]
     old = [[*b.center_um, b.radius_um] for b in case.bodies if b.shape == "disc"]
-    floor = None
-    if below:
-        layer = read_layer(bed.previous_layer)
-        floor = np.column_stack([layer.x_um, 0.5 * layer.spacing_um()])
+    layer = read_layer(bed.previous_layer) if below else None
+    floor = layer.balls_um() if layer else None
     c, r, report = bed_spheres(bed, np.array(old, float).reshape(-1, 4), *size, floor=floor)
-    if below:  # the generator's fractions would count the layer below as void
-        report.update(
-            envelope=math.nan,
-            bulk=math.nan,
-            previous_layer=Path(bed.previous_layer).name,
-            previous_layer_bodies=len(below),
-            previous_layer_points=len(layer.volume),
-        )
+    if layer:
+        report.update(layer.bed_report(bed.previous_layer))
     h = case.grid.spacing_um
     fit = [
         max(report["x_range_um"][1], float(np.max(c[:, 0] + r))),

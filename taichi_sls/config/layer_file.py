@@ -93,6 +93,22 @@ class Layer:
         """Each point's side: the dim-th root of its volume (um)."""
         return self.volume ** (1.0 / self.dim)
 
+    def balls_um(self) -> np.ndarray:
+        """Rows (x, y[, z], r): each point as the disc (sphere) inscribed in its square (cube),
+        what a new bed's particles land on."""
+        return np.column_stack([self.x_um, 0.5 * self.spacing_um()])
+
+    def bed_report(self, path: str) -> dict:
+        """What a bed deposited on this layer adds to its generator's report; the generator's
+        packing fractions would count the layer as void, so they read NaN."""
+        return {
+            "envelope": math.nan,
+            "bulk": math.nan,
+            "previous_layer": Path(path).name,
+            "previous_layer_bodies": len(self.bodies),
+            "previous_layer_points": len(self.volume),
+        }
+
 
 def layer_arrays(
     x_um: np.ndarray,

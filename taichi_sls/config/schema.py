@@ -8,7 +8,6 @@ solver converts to SI (m, K) when it builds its fields. Every check runs here, b
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -108,17 +107,11 @@ class Case(Model):
         below = self._previous_layer(bed)
         if below:  # the new discs land on the layer's points, each a disc in its square
             layer = read_layer(bed.previous_layer)
-            old = np.concatenate([old, np.column_stack([layer.x_um, 0.5 * layer.spacing_um()])])
+            old = np.concatenate([old, layer.balls_um()])
         join = 2.0 * self.contact.fillet_radius_um if self.contact.initial == "fillet" else 0.0
         discs = bed_discs(bed, old, W, H, join)
-        if below:  # the generator's fractions would count the layer below as void
-            discs.report.update(
-                envelope=math.nan,
-                bulk=math.nan,
-                previous_layer=Path(bed.previous_layer).name,
-                previous_layer_bodies=len(below),
-                previous_layer_points=len(layer.volume),
-            )
+        if below:
+            discs.report.update(layer.bed_report(bed.previous_layer))
         h = self.grid.spacing_um
         if W is None:
             right = max(discs.report["x_range_um"][1], float(np.max(discs.x + discs.r)))
@@ -244,9 +237,10 @@ class Case(Model):
             rect = b.shape == "rect"
             if rect and not all(c > a for a, c in zip(b.min_um, b.max_um, strict=True)):
                 raise CaseError(f"{key}.max_um = {b.max_um}: must exceed min_um = {b.min_um}")
-            if b.shape == "points" and read_layer(b.file).dim != self.domain.dim:
+            layer_dim = read_layer(b.file).dim if b.shape == "points" else self.domain.dim
+            if layer_dim != self.domain.dim:
                 raise CaseError(
-                    f"{key}.file = {b.file!r}: a {read_layer(b.file).dim}D layer with "
+                    f"{key}.file = {b.file!r}: a {layer_dim}D layer with "
                     f"domain.dim = {self.domain.dim}; allowed: a layer file written by a "
                     f"{self.domain.dim}D run"
                 )
