@@ -1,0 +1,129 @@
+"""Every answer unchanged through a redesign (issue #52): a fixed set of short runs of bundled
+cases, 2D and 3D, pairs and beds, explicit, implicit and hybrid, settled and not, must reproduce
+the summary, time series and contact table committed from the code before the redesign
+(``tests/data/golden/*.json``).
+
+Explicit runs compare bit for bit: strict floating point and one thread, as in
+test_reference_2d.py (fast math and the order of atomic sums move last bits from one machine or
+run to another). Runs with implicit steps compare to a relative 1e-6: the Newton and Krylov
+solves stop at tolerances of 1e-8 and tighter, so a change that keeps every formula but not the
+order of a reduction moves their answers far below that, and a change of physics far above it.
+
+Regenerate only for a change meant to alter results, and say so in its commit:
+``PYTHONPATH=. python tests/jobs/test_golden_runs.py --write [NAME ...]``."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+GOLDEN = Path(__file__).resolve().parents[1] / "data" / "golden"
+COMMON = [
+    "output.png=false",
+    "output.gif=false",
+    "output.vtu=false",
+    "solver.optimize=false",  # fast compile
+    "solver.fast_math=false",  # the same bits on any CPU
+    "solver.threads=1",  # atomic sums in a fixed order
+]
+# name: (bundled case, overrides, exact)
+RUNS: dict[str, tuple[str, list[str], bool]] = {
+    "pair2d_explicit": ("power25W_coarse", ["time.end_s=2e-5"], True),
+    "pair2d_settled_hybrid": (
+        "power25W_resolved",
+        ["grid.spacing_um=4", "time.stop=end", "time.end_s=2e-5"],
+        False,
+    ),
+    "pair2d_implicit": ("sinter_hold", ["grid.spacing_um=4", "time.end_s=2e-4"], False),
+    "bed2d_hybrid": ("bed_track", ["time.stop=end", "time.end_s=1e-5"], True),
+    "bed2d_implicit_settled": ("machine_layer", ["time.end_s=2e-4"], False),
+    "pair3d_settled_hybrid": ("pair3d_25W", ["time.stop=end", "time.end_s=4e-6"], False),
+    "bed3d_explicit": ("bed3d_cooling", ["time.end_s=2e-6"], True),
+}
+# timing and compile counts vary from run to run
+_VOLATILE = ("wall", "compile", "steps_per_s", "kernels_compiled")
+
+
+def _clean(obj):
+    """Volatile keys dropped, recursively."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items() if not any(w in k for w in _VOLATILE)}
+    if isinstance(obj, list):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def _table(path: Path) -> list[dict[str, str]]:
+    if not path.is_file():
+        return []
+    with path.open() as f:
+        return list(csv.DictReader(f))
+
+
+def run(name: str, out: Path) -> dict:
+    import taichi_sls as sls
+
+    case_name, overrides, _ = RUNS[name]
+    summary = sls.run_case(sls.load_case(case_name, COMMON + overrides), out, progress=False)
+    result = {
+        "summary": _clean(summary),
+        "series": _table(out / "timeseries.csv"),
+        "contacts": _table(out / "contacts.csv"),
+    }
+    # json writes floats by repr (exact round trip) and NaN as NaN: equal text, equal bits
+    return json.loads(json.dumps(result, sort_keys=True))
+
+
+def _number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
+
+
+def _differences(want, got, path: str = "", rel: float = 0.0) -> list[str]:
+    """Where got differs from want: exactly, or beyond ``rel`` for numbers."""
+    if isinstance(want, dict) and isinstance(got, dict):
+        out = [f"{path}/{k}: missing" for k in want if k not in got]
+        out += [f"{path}/{k}: new" for k in got if k not in want]
+        for k in want.keys() & got.keys():
+            out += _differences(want[k], got[k], f"{path}/{k}", rel)
+        return out
+    if isinstance(want, list) and isinstance(got, list):
+        if len(want) != len(got):
+            return [f"{path}: {len(got)} items, want {len(want)}"]
+        return [
+            d
+            for i, (a, b) in enumerate(zip(want, got, strict=True))
+            for d in _differences(a, b, f"{path}[{i}]", rel)
+        ]
+    a, b = _number(want), _number(got)
+    if a is not None and b is not None and not isinstance(want, bool):
+        if math.isnan(a) and math.isnan(b):
+            return []  # NaN (no such neck, say) in both
+        if rel > 0.0 and math.isclose(a, b, rel_tol=rel, abs_tol=rel * 1e-6):
+            return []
+    return [] if want == got else [f"{path}: {got!r}, want {want!r}"]
+
+
+@pytest.mark.parametrize("name", sorted(RUNS))
+def test_short_run_matches_the_golden_record(name, tmp_path):
+    want = json.loads((GOLDEN / f"{name}.json").read_text())
+    got = run(name, tmp_path / name)
+    diffs = _differences(want, got, rel=0.0 if RUNS[name][2] else 1e-6)
+    assert not diffs, f"{name} differs from its golden record:\n" + "\n".join(diffs[:40])
+
+
+if __name__ == "__main__" and sys.argv[1:2] == ["--write"]:
+    import tempfile
+
+    for name in sys.argv[2:] or sorted(RUNS):
+        with tempfile.TemporaryDirectory() as d:
+            result = run(name, Path(d) / name)
+        (GOLDEN / f"{name}.json").write_text(json.dumps(result, sort_keys=True, indent=1) + "\n")
+        print("wrote", name, flush=True)
