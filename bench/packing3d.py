@@ -19,10 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config.deposition import lognormal_diameters
-from ..config.deposition3d import deposit_spheres
-from ..config.packing3d import packing_fractions_3d, slab_volume
-from ..io.atomic import atomic_path
+from taichi_sls.config.deposition import lognormal_diameters
+from taichi_sls.config.deposition3d import deposit_spheres
+from taichi_sls.config.packing3d import packing_fractions_3d, slab_volume
+from taichi_sls.io.atomic import atomic_path
 
 VISSCHER_BOLSTERLI = 0.58  # Nature 239, 504 (1972): sequential deposition with rolling, 3D
 RLP, RCP = 0.55, 0.64  # random loose and random close packing of equal spheres
