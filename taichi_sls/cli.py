@@ -20,6 +20,7 @@ import importlib
 import os
 import signal
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -189,7 +190,9 @@ class _Parser(argparse.ArgumentParser):
     """The top-level parser: a lazy subcommand (``sweep``, ``bench NAME``) is parsed in full by
     the parser its module adds, the module imported only then; the rest parse here."""
 
-    def parse_known_args(self, args=None, namespace=None):  # noqa: ANN001, ANN201
+    def parse_known_args(
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
         argv = sys.argv[1:] if args is None else list(args)
         if argv[:1] == ["sweep"]:
             command, name, module = "sweep", "sweep", "taichi_sls.studies.sweep.runner"
