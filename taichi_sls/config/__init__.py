@@ -14,8 +14,10 @@ from .loading import (
     deep_update,
     load_case,
     read_toml,
+    validate_case,
 )
 from .materials import Material
+from .resolve import ResolvedCase, resolve
 from .schema import Case
 
 __all__ = [
@@ -29,6 +31,7 @@ __all__ = [
     "Polygon",
     "Prism",
     "Rect",
+    "ResolvedCase",
     "apply_override",
     "bundled_case",
     "bundled_cases",
@@ -38,4 +41,6 @@ __all__ = [
     "deep_update",
     "load_case",
     "read_toml",
+    "resolve",
+    "validate_case",
 ]

@@ -13,6 +13,7 @@ import tomli_w
 from pydantic import ValidationError
 
 from .errors import CaseError, case_error
+from .resolve import ResolvedCase, resolve
 from .schema import Case
 
 T = TypeVar("T")
@@ -101,12 +102,18 @@ def apply_override(data: dict, text: str) -> None:
         node[last] = value
 
 
-def case_from_dict(data: dict) -> Case:
-    """Build and validate a :class:`Case` from raw TOML data."""
+def validate_case(data: dict) -> Case:
+    """Validate raw TOML data as a :class:`Case` (checks only: ``data`` and nothing else is
+    changed, and nothing is derived yet)."""
     try:
         return Case.model_validate(data)
     except ValidationError as e:
         raise case_error(e, Case, data) from None
+
+
+def case_from_dict(data: dict) -> ResolvedCase:
+    """Validate raw TOML data and resolve it (config/resolve.py): the case a run takes."""
+    return resolve(validate_case(data))
 
 
 def resolve_files(data: dict, folder: Path) -> None:
@@ -121,9 +128,9 @@ def resolve_files(data: dict, folder: Path) -> None:
             table[key] = str((folder / f).resolve())
 
 
-def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
+def load_case(path: str | Path, overrides: list[str] | None = None) -> ResolvedCase:
     """Read a case file (a path, or the name of a bundled case), apply ``--set`` overrides,
-    validate, return the :class:`Case`."""
+    validate and resolve it: the :class:`ResolvedCase` a run takes."""
     path = find_case(path)
     data = read_toml(path, "case file")
     for o in overrides or []:
@@ -144,14 +151,19 @@ def in_file(path: Path, build: Callable[[dict], T], data: dict) -> T:
 
 
 def case_to_dict(case: Case) -> dict:
-    """The resolved case as plain data (None values dropped: TOML has no null; a 2D case has no
-    walls in z)."""
+    """A case as plain data (None values dropped: TOML has no null; a 2D case has no walls in
+    z; a side a [bed] is to fit stays unset). It loads back to the same case."""
     z_walls = {"boundary": {"front", "back"}} if case.domain.dim == 2 else None
-    return case.model_dump(exclude_none=True, exclude=z_walls)
+    out = case.model_dump(exclude_none=True, exclude=z_walls)
+    if case.bed is not None:
+        for key in ("width_um", "height_um"):
+            if key not in case.domain.model_fields_set:
+                del out["domain"][key]
+    return out
 
 
 def case_to_toml(case: Case) -> str:
-    """The resolved case as TOML text: every default filled in; it loads back to the same case."""
+    """A case as TOML text: every default filled in; it loads back to the same case."""
     return tomli_w.dumps(case_to_dict(case))
 
 

@@ -99,7 +99,7 @@ def test_density_before_is_the_beds_packing_and_the_melt_densifies(runs):
     it lies within [envelope, envelope + 0.04]. Heated, the layer sinks and densifies."""
     case, folder = runs["laser"]
     d = _bed(folder)["relative_density"]
-    assert d["generator_envelope"] == pytest.approx(case.bed_report()["envelope"])
+    assert d["generator_envelope"] == pytest.approx(case.bed_report["envelope"])
     assert d["generator_envelope"] <= d["initial"] <= d["generator_envelope"] + 0.04
     assert d["final"] > d["initial"] and d["mean_top_final_um"] < d["mean_top_initial_um"]
     dark = _bed(runs["dark"][1])["relative_density"]
