@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 import tomli_w
 from pydantic import ValidationError
 
+from .base_case import over_base
 from .errors import CaseError, case_error
 from .resolve import ResolvedCase, resolve
 from .schema import Case
@@ -128,11 +129,53 @@ def resolve_files(data: dict, folder: Path) -> None:
             table[key] = str((folder / f).resolve())
 
 
-def load_case(path: str | Path, overrides: list[str] | None = None) -> ResolvedCase:
-    """Read a case file (a path, or the name of a bundled case), apply ``--set`` overrides,
-    validate and resolve it: the :class:`ResolvedCase` a run takes."""
-    path = find_case(path)
+def read_case_file(path: Path) -> dict:
+    """A case file's raw data over its ``base`` case's (base_case.py), followed from base to
+    base; the bases' files made absolute (the file's own are left to the caller)."""
+    return _over_bases(path, ())
+
+
+def _over_bases(path: Path, seen: tuple[Path, ...]) -> dict:
     data = read_toml(path, "case file")
+    if "base" not in data:
+        return data
+    name = data.pop("base")
+    base = find_base(name, path)
+    chain = (*seen, path.resolve())
+    if base.resolve() in chain:
+        cycle = " -> ".join(p.name for p in (*chain, base))
+        raise CaseError(
+            f"{path}: base = {name!r}: a cycle of bases ({cycle}); allowed: a case "
+            "that does not lead back to this file"
+        )
+    below = _over_bases(base, chain)
+    resolve_files(below, base.parent)
+    if isinstance(below.get("case"), dict):
+        below["case"].pop("name", None)  # a case is named by its own file
+    try:
+        return over_base(below, data)
+    except CaseError as e:
+        raise CaseError(f"{path}: {e}") from None
+
+
+def find_base(name: Any, path: Path) -> Path:
+    """The file a case file's ``base`` names: a path relative to the file, else a bundled case
+    by name."""
+    if not isinstance(name, str) or not name:
+        raise CaseError(f"{path}: base = {name!r}: expected a case name or a case file's path")
+    for p in (path.parent / name, path.parent / f"{name}.toml", bundled_root() / f"{name}.toml"):
+        if p.is_file():
+            return p
+    raise CaseError(
+        f"{path}: base = {name!r}: no such case file (relative to {path.parent}) or bundled case"
+    )
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> ResolvedCase:
+    """Read a case file (a path, or the name of a bundled case) over its ``base``, apply
+    ``--set`` overrides, validate and resolve it: the :class:`ResolvedCase` a run takes."""
+    path = find_case(path)
+    data = read_case_file(path)
     for o in overrides or []:
         apply_override(data, o)
     if "case" not in data or "name" not in data.get("case", {}):
