@@ -1,5 +1,6 @@
-"""Case files: the validated schema, TOML loading with ``--set`` overrides, and the generated
-key reference. The lowest layer: it imports nothing else of the package."""
+"""Case files: the validated schema, its resolution (resolve.py), TOML loading with a ``base``
+and ``--set`` overrides, and the generated key reference. The lowest layer: it imports nothing
+else of the package."""
 
 from .bed import Bed
 from .bodies import Body, Cylinder, Disc, Polygon, Prism, Rect
