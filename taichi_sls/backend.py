@@ -42,9 +42,3 @@ def load(name: str | None = None) -> ModuleType:
 
 ti = load()
 NAME: str = next(k for k, v in BACKENDS.items() if v == ti.__name__)
-
-# the front end's memos (taichi_sls/front_end.py), before any of the solver's functions is
-# decorated: Taichi inspects each decorating frame
-from taichi_sls import front_end  # noqa: E402
-
-front_end.install(ti)

@@ -1,5 +1,6 @@
-"""Case files: the validated schema, TOML loading with ``--set`` overrides, and the generated
-key reference. The lowest layer: it imports nothing else of the package."""
+"""Case files: the validated schema, its resolution (resolve.py), TOML loading with a ``base``
+and ``--set`` overrides, and the generated key reference. The lowest layer: it imports nothing
+else of the package."""
 
 from .bed import Bed
 from .bodies import Body, Cylinder, Disc, Polygon, Prism, Rect
@@ -14,8 +15,10 @@ from .loading import (
     deep_update,
     load_case,
     read_toml,
+    validate_case,
 )
 from .materials import Material
+from .resolve import ResolvedCase, resolve
 from .schema import Case
 
 __all__ = [
@@ -29,6 +32,7 @@ __all__ = [
     "Polygon",
     "Prism",
     "Rect",
+    "ResolvedCase",
     "apply_override",
     "bundled_case",
     "bundled_cases",
@@ -38,4 +42,6 @@ __all__ = [
     "deep_update",
     "load_case",
     "read_toml",
+    "resolve",
+    "validate_case",
 ]

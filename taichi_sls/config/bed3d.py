@@ -1,78 +1,23 @@
 """The ``[bed]`` of a 3D case (``domain.dim = 3``): spheres deposited by random sequential
 deposition with rolling (deposition3d.py) between the domain's side walls, read from a CSV file
-of spheres, or both, turned into ``[[bodies]]`` spheres when the case is validated, as the 2D
-bed's discs are (bed.py; docs/beds.md, "3D beds")."""
+of spheres, or both, turned into ``[[bodies]]`` spheres when the case is resolved (resolve.py),
+as the 2D bed's discs are (bed.py; docs/beds.md, "3D beds")."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from .bed import Bed, bed_diameters, check_csv_rows, read_columns
-from .bodies import Disc
 from .deposition3d import deposit_spheres
 from .errors import CaseError
-from .layer_file import read_layer
 from .packing3d import packing_fractions_3d
 
 MAX_SPHERES = 20_000  # the generator takes about a minute at this count
 FCC = math.pi / (3 * math.sqrt(2))  # densest packing of spheres: no bed can exceed it
 COLUMNS = ("x_um", "y_um", "z_um", "radius_um")
-
-
-def expand_bed_3d(case: Any, below: list | None = None) -> None:
-    """Replace ``case.bed`` by its spheres, appended to ``case.bodies`` (the resolved case lists
-    them and loads back to the same bed); an unset domain width, height or depth is fitted to
-    the bed (its x and z ranges; its top plus one mean diameter), in whole cells. ``below``: the
-    bodies of ``bed.previous_layer`` (LayerBody), listed before the new spheres, which land on
-    its points (each a sphere in its cube, as 2D's discs land on squares)."""
-    bed: Bed = case.bed
-    if bed.material not in case.materials:
-        raise CaseError(
-            f"bed.material = {bed.material!r}: no such material; defined: "
-            f"{', '.join(case.materials)}"
-        )
-    given = case.domain.model_fields_set
-    size = [
-        case.domain.width_um if "width_um" in given else None,
-        case.domain.height_um if "height_um" in given else None,
-        None,
-    ]
-    # without depth_um the domain is as deep as it is wide (Domain.depth)
-    size[2] = case.domain.depth_um if case.domain.depth_um is not None else size[0]
-    old = [[*b.center_um, b.radius_um] for b in case.bodies if b.shape == "disc"]
-    layer = read_layer(bed.previous_layer) if below else None
-    floor = layer.balls_um() if layer else None
-    c, r, report = bed_spheres(bed, np.array(old, float).reshape(-1, 4), *size, floor=floor)
-    if layer:
-        report.update(layer.bed_report(bed.previous_layer))
-    h = case.grid.spacing_um
-    fit = [
-        max(report["x_range_um"][1], float(np.max(c[:, 0] + r))),
-        float(np.max(c[:, 1] + r)) + 2.0 * float(np.mean(r)),
-        max(report["z_range_um"][1], float(np.max(c[:, 2] + r))),
-    ]
-    for key, s, f in zip(("width_um", "height_um", "depth_um"), size, fit, strict=True):
-        if s is None:
-            setattr(case.domain, key, h * math.ceil(f / h - 1e-9))
-    case.bodies = [
-        *case.bodies,
-        *(below or []),
-        *(
-            Disc(
-                center_um=[float(v) for v in ci],
-                radius_um=float(ri),
-                material=bed.material,
-                temperature_C=bed.temperature_C,
-            )
-            for ci, ri in zip(c, r, strict=True)
-        ),
-    ]
-    case.bed = None
-    case._bed_report = report
 
 
 def _ranges(bed: Bed, width, depth, csv: np.ndarray) -> list[tuple[float, float]]:

@@ -57,7 +57,7 @@ def check_dimension(case: Any) -> None:
 
 def _check_lasers_3d(case: Any) -> None:
     """The 3D spot (physics/laser.py): tracks lie in the bed, so no plane to cross; the end key
-    names the scan axis; z_start_um defaults to the mid-depth (set here, so a dump carries it)."""
+    names the scan axis (z_start_um's default, the mid-depth, is set by config/resolve.py)."""
     for i, las in enumerate(case.lasers):
         if las.scan == "across":
             raise CaseError(
@@ -75,8 +75,6 @@ def _check_lasers_3d(case: Any) -> None:
                 f"lasers[{i}].return_s = None: {las.tracks} tracks need the time between "
                 "their starts (allowed: > 0 s)"
             )
-        if las.z_start_um is None:
-            las.z_start_um = 0.5 * case.domain.depth()
 
 
 def _check_coordinates(case: Any, dim: int) -> None:
@@ -127,16 +125,3 @@ def _refuse_in_3d(case: Any) -> None:
             f'solver.layout = "blocks" with domain.dim = 3: the race-free colouring is 4 '
             f'colours of 2D blocks, {not_yet}; allowed in 3D: "auto", "serial", "parallel"'
         )
-
-
-def unset_laser_depths(case: Any) -> list[int]:
-    """The lasers whose z_start_um the case leaves to its default (read before any check)."""
-    return [i for i, las in enumerate(case.lasers) if las.z_start_um is None]
-
-
-def default_laser_depths(case: Any, unset: list[int]) -> None:
-    """z_start_um's default, the mid-depth, taken again once a [bed] has fitted the depth (the
-    first check ran before the bed set it)."""
-    if case.domain.dim == 3:
-        for i in unset:
-            case.lasers[i].z_start_um = 0.5 * case.domain.depth()

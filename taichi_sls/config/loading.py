@@ -12,7 +12,9 @@ from typing import Any, TypeVar
 import tomli_w
 from pydantic import ValidationError
 
+from .base_case import over_base
 from .errors import CaseError, case_error
+from .resolve import ResolvedCase, resolve
 from .schema import Case
 
 T = TypeVar("T")
@@ -101,12 +103,18 @@ def apply_override(data: dict, text: str) -> None:
         node[last] = value
 
 
-def case_from_dict(data: dict) -> Case:
-    """Build and validate a :class:`Case` from raw TOML data."""
+def validate_case(data: dict) -> Case:
+    """Validate raw TOML data as a :class:`Case` (checks only: ``data`` and nothing else is
+    changed, and nothing is derived yet)."""
     try:
         return Case.model_validate(data)
     except ValidationError as e:
         raise case_error(e, Case, data) from None
+
+
+def case_from_dict(data: dict) -> ResolvedCase:
+    """Validate raw TOML data and resolve it (config/resolve.py): the case a run takes."""
+    return resolve(validate_case(data))
 
 
 def resolve_files(data: dict, folder: Path) -> None:
@@ -121,11 +129,53 @@ def resolve_files(data: dict, folder: Path) -> None:
             table[key] = str((folder / f).resolve())
 
 
-def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
-    """Read a case file (a path, or the name of a bundled case), apply ``--set`` overrides,
-    validate, return the :class:`Case`."""
-    path = find_case(path)
+def read_case_file(path: Path) -> dict:
+    """A case file's raw data over its ``base`` case's (base_case.py), followed from base to
+    base; the bases' files made absolute (the file's own are left to the caller)."""
+    return _over_bases(path, ())
+
+
+def _over_bases(path: Path, seen: tuple[Path, ...]) -> dict:
     data = read_toml(path, "case file")
+    if "base" not in data:
+        return data
+    name = data.pop("base")
+    base = find_base(name, path)
+    chain = (*seen, path.resolve())
+    if base.resolve() in chain:
+        cycle = " -> ".join(p.name for p in (*chain, base))
+        raise CaseError(
+            f"{path}: base = {name!r}: a cycle of bases ({cycle}); allowed: a case "
+            "that does not lead back to this file"
+        )
+    below = _over_bases(base, chain)
+    resolve_files(below, base.parent)
+    if isinstance(below.get("case"), dict):
+        below["case"].pop("name", None)  # a case is named by its own file
+    try:
+        return over_base(below, data)
+    except CaseError as e:
+        raise CaseError(f"{path}: {e}") from None
+
+
+def find_base(name: Any, path: Path) -> Path:
+    """The file a case file's ``base`` names: a path relative to the file, else a bundled case
+    by name."""
+    if not isinstance(name, str) or not name:
+        raise CaseError(f"{path}: base = {name!r}: expected a case name or a case file's path")
+    for p in (path.parent / name, path.parent / f"{name}.toml", bundled_root() / f"{name}.toml"):
+        if p.is_file():
+            return p
+    raise CaseError(
+        f"{path}: base = {name!r}: no such case file (relative to {path.parent}) or bundled case"
+    )
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> ResolvedCase:
+    """Read a case file (a path, or the name of a bundled case) over its ``base``, apply
+    ``--set`` overrides, validate and resolve it: the :class:`ResolvedCase` a run takes."""
+    path = find_case(path)
+    data = read_case_file(path)
     for o in overrides or []:
         apply_override(data, o)
     if "case" not in data or "name" not in data.get("case", {}):
@@ -144,14 +194,19 @@ def in_file(path: Path, build: Callable[[dict], T], data: dict) -> T:
 
 
 def case_to_dict(case: Case) -> dict:
-    """The resolved case as plain data (None values dropped: TOML has no null; a 2D case has no
-    walls in z)."""
+    """A case as plain data (None values dropped: TOML has no null; a 2D case has no walls in
+    z; a side a [bed] is to fit stays unset). It loads back to the same case."""
     z_walls = {"boundary": {"front", "back"}} if case.domain.dim == 2 else None
-    return case.model_dump(exclude_none=True, exclude=z_walls)
+    out = case.model_dump(exclude_none=True, exclude=z_walls)
+    if case.bed is not None:
+        for key in ("width_um", "height_um"):
+            if key not in case.domain.model_fields_set:
+                del out["domain"][key]
+    return out
 
 
 def case_to_toml(case: Case) -> str:
-    """The resolved case as TOML text: every default filled in; it loads back to the same case."""
+    """A case as TOML text: every default filled in; it loads back to the same case."""
     return tomli_w.dumps(case_to_dict(case))
 
 

@@ -10,13 +10,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-from pydantic import Field, PrivateAttr, model_validator
+from pydantic import Field, model_validator
 
-from .bed import Bed, bed_discs
-from .bed3d import expand_bed_3d
-from .bodies import EXTRUDED, Body, Disc, LayerBody
-from .dim import check_dimension, default_laser_depths, unset_laser_depths
+from .bed import Bed
+from .bodies import EXTRUDED, Body, Disc
+from .dim import check_dimension
 from .errors import CaseError
 from .layer_file import read_layer
 from .materials import Material
@@ -64,8 +62,6 @@ class Case(Model):
     output: Output = Field(default_factory=Output)
     fusion: Fusion = Field(default_factory=Fusion)
     contact: Contact = Field(default_factory=Contact)
-    # what the [bed] was (source, disc count, packing fractions) once its discs are bodies
-    _bed_report: dict | None = PrivateAttr(None)
 
     @model_validator(mode="before")
     @classmethod
@@ -84,113 +80,37 @@ class Case(Model):
             ]
         return data
 
-    def _expand_bed(self) -> None:
-        """The [bed]'s discs become bodies after the [[bodies]], and the table goes (the resolved
-        case lists the discs, so it loads back to the same bed). An unset domain width or height
-        is fitted to the bed: its x range, and its top plus one mean diameter, in whole cells."""
-        bed = self.bed
-        if bed is None:
-            return
-        if self.domain.dim == 3:
-            expand_bed_3d(self, self._previous_layer(bed))
-            return
-        if bed.material not in self.materials:
-            raise CaseError(
-                f"bed.material = {bed.material!r}: no such material; defined: "
-                f"{', '.join(self.materials)}"
-            )
-        given = self.domain.model_fields_set
-        W = self.domain.width_um if "width_um" in given else None
-        H = self.domain.height_um if "height_um" in given else None
-        old = [[*b.center_um, b.radius_um] for b in self.bodies if b.shape == "disc"]
-        old = np.array(old, dtype=float).reshape(-1, 3)
-        below = self._previous_layer(bed)
-        if below:  # the new discs land on the layer's points, each a disc in its square
-            layer = read_layer(bed.previous_layer)
-            old = np.concatenate([old, layer.balls_um()])
-        join = 2.0 * self.contact.fillet_radius_um if self.contact.initial == "fillet" else 0.0
-        discs = bed_discs(bed, old, W, H, join)
-        if below:
-            discs.report.update(layer.bed_report(bed.previous_layer))
-        h = self.grid.spacing_um
-        if W is None:
-            right = max(discs.report["x_range_um"][1], float(np.max(discs.x + discs.r)))
-            self.domain.width_um = h * math.ceil(right / h - 1e-9)
-        if H is None:
-            top = float(np.max(discs.y + discs.r)) + 2.0 * float(np.mean(discs.r))
-            self.domain.height_um = h * math.ceil(top / h - 1e-9)
-        self.bodies = [
-            *self.bodies,
-            *below,
-            *(
-                Disc(
-                    center_um=[float(x), float(y)],
-                    radius_um=float(r),
-                    material=bed.material,
-                    temperature_C=bed.temperature_C,
-                )
-                for x, y, r in zip(discs.x, discs.y, discs.r, strict=True)
-            ),
-        ]
-        self.bed = None
-        self._bed_report = discs.report
-
-    def _previous_layer(self, bed: Bed) -> list[LayerBody]:
-        """The bodies of ``bed.previous_layer`` (none without one), checked against the case:
-        their materials exist and their points were seeded at this case's point spacing."""
-        if bed.previous_layer is None:
-            return []
-        layer = read_layer(bed.previous_layer)
-        key = f"bed.previous_layer = {bed.previous_layer!r}"
-        if layer.dim != self.domain.dim:
-            raise CaseError(
-                f"{key}: a {layer.dim}D layer (x_um with {layer.dim} columns) with domain.dim = "
-                f"{self.domain.dim}; allowed: a layer file written by a {self.domain.dim}D run"
-            )
-        spacing = self.grid.spacing_um / self.grid.points_per_cell
-        seeded = float(np.median(layer.spacing_um()))  # most are whole points
-        if not 0.8 * spacing <= seeded <= 1.25 * spacing:
-            raise CaseError(
-                f"{key}: its points are {seeded:.3g} um apart, this case seeds them "
-                f"{spacing:.3g} um apart (grid.spacing_um / grid.points_per_cell); allowed: a "
-                "layer run on the same grid"
-            )
-        out = []
-        for b in layer.bodies:
-            names = {layer.material_names[m] for m in np.unique(layer.material[layer.body == b])}
-            missing = sorted(names - set(self.materials))
-            if missing:
-                raise CaseError(
-                    f"{key}: body {b} is of material {missing[0]!r}, not defined here; "
-                    f"defined: {', '.join(self.materials)}"
-                )
-            out.append(
-                LayerBody(
-                    shape="points",
-                    file=bed.previous_layer,
-                    body=int(b),
-                    material=sorted(names)[0],
-                    temperature_C=bed.temperature_C,
-                )
-            )
-        return out
-
-    def bed_report(self) -> dict | None:
-        """The [bed] this case was built from: source, disc count, packing fractions
-        (envelope, bulk) and mean top height (um); None without a bed."""
-        return self._bed_report
-
     @model_validator(mode="after")
     def _cross_checks(self) -> Case:
-        """What a field type alone cannot express."""
-        unset_depths = unset_laser_depths(self)
+        """What a field type alone cannot express. Checks only: nothing here changes the case
+        (what derives from it is built by config/resolve.py). With a [bed], the domain and the
+        bodies are checked on the resolved case, once the bed's bodies are in a fitted domain."""
         check_dimension(self)
         check_symmetry(self)
-        check_overlaps(self.bodies, self.contact.allow_overlap)  # the case's own, before the bed
-        self._expand_bed()
-        default_laser_depths(self, unset_depths)
-        if not self.bodies:
+        check_overlaps(self._bodies_to_check_overlaps(), self.contact.allow_overlap)
+        if self.bed is None and not self.bodies:
             raise CaseError(f"bodies = []: {NO_BODIES}")
+        if self.bed is not None and self.bed.material not in self.materials:
+            raise CaseError(
+                f"bed.material = {self.bed.material!r}: no such material; defined: "
+                f"{', '.join(self.materials)}"
+            )
+        if self.bed is None:
+            self._check_domain()
+        self._check_materials()
+        if self.bed is None:
+            self._check_bodies()
+        self._check_lasers()
+        self._check_solver()
+        return self
+
+    def _bodies_to_check_overlaps(self) -> list[Body]:
+        """The bodies whose overlaps validation refuses: the case's own (a [bed]'s are checked
+        against bed.overlap_tolerance_um by its generator)."""
+        return self.bodies
+
+    def _check_domain(self) -> None:
+        """The grid fits the domain and the machine's memory."""
         sides = self.domain_um()
         h = self.grid.spacing_um
         if h > min(sides) / 2:
@@ -202,6 +122,9 @@ class Case(Model):
                 f"{' x '.join(f'{s}' for s in sides)} um domain; at most "
                 f"{MAX_CELLS:.0e} are allowed (memory)"
             )
+
+    def _check_materials(self) -> None:
+        """Each material's transition temperatures in order; one crystallisation model."""
         for name, m in self.materials.items():
             if not m.crystallization_C < m.melt_C:
                 raise CaseError(
@@ -226,6 +149,10 @@ class Case(Model):
                     f"with T_low < T_high <= crystallization_C = {m.crystallization_C} (the "
                     "crystallisation range lies below the melting range, without overlap)"
                 )
+
+    def _check_bodies(self) -> None:
+        """Each body of a defined material, well formed and inside the domain."""
+        sides = self.domain_um()
         eps = 1e-9 * max(sides)
         for i, b in enumerate(self.bodies):
             key = f"bodies[{i}]"
@@ -261,6 +188,9 @@ class Case(Model):
                     f"{key}: extent {span} um lies outside the domain "
                     f"{' x '.join(f'0..{s}' for s in sides)} um"
                 )
+
+    def _check_lasers(self) -> None:
+        """Each laser's times and scan keys consistent."""
         for i, las in enumerate(self.lasers):
             if las.off_s < las.on_s:
                 raise CaseError(f"lasers[{i}].off_s = {las.off_s}: must be >= on_s = {las.on_s}")
@@ -296,6 +226,9 @@ class Case(Model):
                         f"lasers[{i}].return_s = {las.return_s}: shorter than a pass, 6 r0 / v "
                         f"= {passage:g} s (allowed: >= {passage:g})"
                     )
+
+    def _check_solver(self) -> None:
+        """The solver's, the integrator's and the stop's switches compatible."""
         if self.solver.stress_reading == "paper" and self.solver.strain == "finite":
             raise CaseError(
                 'solver.stress_reading = "paper" with solver.strain = "finite": the printed '
@@ -345,7 +278,6 @@ class Case(Model):
                 f"time.max_s = {self.time.max_s}: must exceed the time every laser is off "
                 f"({self.lasers_off_s():g} s)"
             )
-        return self
 
     def domain_um(self) -> tuple[float, ...]:
         """The domain's sides (um): width, height[, depth in 3D]."""

@@ -324,10 +324,10 @@ class Laser(Model):
         description="eq. 31 read as W/m^3 (docs/model.md) or, as printed in eq. 3, W/kg multiplied "
         "by rho",
     )
-    depth_sign: Literal["decay", "paper"] = Field(
+    depth_sign: Literal["decay"] = Field(
         "decay",
-        description="decay: exp(-(y_l - y)/eta) (docs/model.md); paper: exp(+(y_l - y)/eta) as "
-        "printed",
+        description="decay: exp(-(y_l - y)/eta) (docs/model.md); the printed exp(+(y_l - y)/eta) "
+        '("paper"), which grows with depth, is no longer offered',
     )
 
     def track_windows_along_s(self) -> list[tuple[float, float]]:

@@ -28,10 +28,10 @@ class SurfaceTension(Model):
         "least-squares curvature and CSF force (eqs. 19-24; the keys from point_radius_over_h "
         "to curvature_step_fraction)",
     )
-    surface_energy_colour: Literal["mass", "volume"] = Field(
+    surface_energy_colour: Literal["mass"] = Field(
         "mass",
         description="surface_energy: colour from the node mass m_i / (rho V_c) (rho of the first "
-        "body's material) or from the point volumes sum V_p N_i / V_c",
+        "body's material); the point volumes' sum V_p N_i / V_c (\"volume\") is no longer offered",
     )
     surface_energy_colour_filter: bool = Field(
         True,
@@ -70,10 +70,10 @@ class SurfaceTension(Model):
         description="r_p / h in eq. 21; > sqrt(2)/4 so interior nodes read inside",
     )
     band_cells: int = Field(3, gt=0, le=8, description="half-width of the level-set band (cells)")
-    level_set: Literal["redistanced", "raw"] = Field(
+    level_set: Literal["redistanced"] = Field(
         "redistanced",
-        description="redistanced: signed distance to the eq. 21 zero contour; raw: eq. 21 as "
-        "printed",
+        description="redistanced: signed distance to the eq. 21 zero contour; eq. 21 as printed "
+        '("raw") is no longer offered',
     )
     level_set_smoothing_passes: int = Field(
         8, ge=0, le=64, description="binomial smoothing passes over phi before the fit"

@@ -79,8 +79,10 @@ class OutputWriter:
 
     # ----------------------------------------------------------------- simple files
 
-    def write_case(self, toml_text: str) -> None:
-        atomic_write_text(self.out_dir / "case.toml", toml_text)
+    def write_case(self, toml_text: str, name: str = "case.toml") -> None:
+        """A case file into the folder: the case as given (case.toml), or as resolved, what
+        ran (resolved.toml)."""
+        atomic_write_text(self.out_dir / name, toml_text)
 
     def summary(self, data: dict) -> None:
         write_summary(self.out_dir / "summary.json", data)

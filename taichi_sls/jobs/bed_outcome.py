@@ -163,7 +163,7 @@ class ContactHistory:
 def layer_density(sim: Simulation) -> dict[str, float]:
     """The layer's relative density now (jobs/bed_layer.py) between the bed's side walls."""
     cfg = sim.state.cfg
-    rep = sim.case.bed_report()
+    rep = sim.case.bed_report
     if cfg.dim == 3:
         return _layer_density_3d(sim, rep)
     if rep is not None:
@@ -258,7 +258,7 @@ def bed_summary(
         melt = melt_extent(pt["x0"], pt["time_molten"], top, spacing)
     else:
         melt = melt_extent(pt["x0"], pt["time_molten"], top, spacing, track_across_axis(sim.case))
-    rep = sim.case.bed_report() or {}
+    rep = sim.case.bed_report or {}
     record = {
         "contacts": n,
         "fused": int(col["fused"].sum()),

@@ -2,9 +2,9 @@
 
 Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``animation.gif``,
 ``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``outcome.png``,
-``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
-``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed) adds
-``contacts.csv`` and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py),
+``summary.json`` (with the fusion ``outcome``), ``case.toml`` (as given) and ``resolved.toml``
+(as run), with ``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed)
+adds ``contacts.csv`` and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py),
 the bed's own columns of the time series and plots (the layer's density, melt and contacts
 over time: io/series.BED_PANELS; the contacts map and necks: io/bed_outcome_plot.py),
 its verdict per contact, and ``layer.npz``, its points at the end (``bed.previous_layer`` of a
@@ -114,7 +114,8 @@ def run_case(
     sim = Simulation(case, scene=scene, before_step=before_step)
     sc = sim.scene
     writer = _writer(case, out_dir)
-    writer.write_case(case_to_toml(case))
+    writer.write_case(case_to_toml(getattr(case, "given", None) or case))
+    writer.write_case(case_to_toml(case), "resolved.toml")
     schedule = list(frame_steps(case, sim.dt))
     solidify = case.time.stop == "solidified"
     horizon = case.time.max_s if solidify else schedule[-1] * sim.dt
@@ -264,7 +265,7 @@ def run_case(
             baseline_um=baseline_um,
         )
         if bed is not None and case.domain.dim == 3:  # the 3D generator's own report
-            summary["bed_generator"] = case.bed_report()
+            summary["bed_generator"] = case.bed_report
         if bed is not None:
             summary["outcome"].update(
                 fused=None,

@@ -62,16 +62,11 @@ def curvature(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: t
                 pxx, pyy, pxy = 2.0 * c[3] / (h * h), 2.0 * c[4] / (h * h), c[5] / (h * h)
                 g2 = px * px + py * py
                 g = ti.sqrt(g2)
-                gmin = 0.5 if ti.static(cfg.redistance) else 1e-12
-                if g > gmin:
+                if g > 0.5:  # phi is a signed distance: |grad phi| = 1 away from its kinks
                     kn = (pxx * py * py - 2.0 * px * py * pxy + pyy * px * px) / (g2 * g)
-                    if ti.static(cfg.redistance):
-                        den = 1.0 - nd.phi_smooth[i, j] * kn
-                        if den > 0.25:
-                            k = kn / den
-                            ok = CURVATURE
-                    else:
-                        k = kn
+                    den = 1.0 - nd.phi_smooth[i, j] * kn
+                    if den > 0.25:
+                        k = kn / den
                         ok = CURVATURE
         nd.kappa[i, j] = k
         nd.flags[i, j] = ok

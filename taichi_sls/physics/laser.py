@@ -4,8 +4,7 @@ with depth below the top of the powder).
 Each beam is one element of a struct field whose members are in SI (the case's ``_um`` keys in
 metres): ``on_s``, ``off_s``, ``x_start_m``, ``speed_m_s``, ``x_end_m``, ``top_m``,
 ``spot_radius_m``, ``penetration_depth_m``, ``amplitude_W_m3`` (2 A P / (pi r0^2 eta) times the
-depth factor, times rho for the printed per-mass reading) and ``depth_sign`` (+1 decay, -1 the
-printed sign).
+depth factor, times rho for the printed per-mass reading).
 
 Hatches (``across`` = 1, docs/model.md "Hatches"): the plane is a section across parallel tracks.
 Track k runs normal to the plane at x_k = ``x_start_m`` + k ``hatch_m``; its spot crosses the
@@ -35,7 +34,6 @@ LASER_MEMBERS = (
     "amplitude_W_m3",
     "spot_radius_m",
     "penetration_depth_m",
-    "depth_sign",
     "across",
     "tracks",
     "hatch_m",
@@ -148,7 +146,7 @@ def laser_source(cfg: ti.template(), lasers: ti.template(), xp, t, dt, column_to
             s += (
                 las.amplitude_W_m3
                 * spot_source_3d(las, xp, t, dt)
-                * ti.exp(-las.depth_sign * depth / las.penetration_depth_m)
+                * ti.exp(-depth / las.penetration_depth_m)
             )
             continue
         if las.across > 0.0:
@@ -156,7 +154,7 @@ def laser_source(cfg: ti.template(), lasers: ti.template(), xp, t, dt, column_to
             s += (
                 las.amplitude_W_m3
                 * hatch_source(las, xp, t, dt)
-                * ti.exp(-las.depth_sign * depth / las.penetration_depth_m)
+                * ti.exp(-depth / las.penetration_depth_m)
             )
             continue
         on = las.on_s
@@ -174,6 +172,6 @@ def laser_source(cfg: ti.template(), lasers: ti.template(), xp, t, dt, column_to
                 las.amplitude_W_m3
                 * ((t1 - t0) / dt)
                 * ti.exp(-2.0 * dx * dx / (r0 * r0))
-                * ti.exp(-las.depth_sign * depth / eta)
+                * ti.exp(-depth / eta)
             )
     return s

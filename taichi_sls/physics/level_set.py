@@ -3,10 +3,10 @@
 1. **Level set from the points** (eq. 21): phi_raw(x_i) = min_p |x_i - x_p| - r_p, scattered by
    each point onto the 5x5 nodes around it (O(points) work). It is a distance outside the body
    but a plateau near -r_p inside, where eq. 24 would divide by a vanishing gradient.
-2. **Redistancing** (``surface_tension.level_set = "redistanced"``, default): the zero contour of
-   phi_raw is traced by marching squares (linear interpolation on cell edges, saddles resolved
-   by the cell-centre value) and every node within ``band_cells`` of it gets the signed distance
-   to the nearest contour segment. ``"raw"`` keeps eq. 21 as printed.
+2. **Redistancing** (``surface_tension.level_set = "redistanced"``, the only reading): the zero
+   contour of phi_raw is traced by marching squares (linear interpolation on cell edges, saddles
+   resolved by the cell-centre value) and every node within ``band_cells`` of it gets the signed
+   distance to the nearest contour segment (eq. 21 as printed is no longer offered).
 3. **Blur** before the curvature fit: ``level_set_smoothing_passes`` binomial passes (a Gaussian
    blur; a circle stays a circle, shrunk by sigma^2 / 2R).
 
@@ -61,21 +61,19 @@ def redistance(cfg: ti.template(), box: ti.template(), nd: ti.template(), seg: t
     nb = ti.static(cfg.band)
     for i, j in ti.ndrange(*active(box)):
         f = nd.phi_raw[i, j]
-        out = f
-        if ti.static(cfg.redistance):
-            sgn = 1.0 if f >= 0.0 else -1.0
-            out = sgn * cfg.phi_cap
-            if f < cfg.phi_cap:
-                x = ti.cast(ti.Vector([i, j]) - cfg.off, float) * cfg.h
-                d2 = cfg.phi_cap * cfg.phi_cap
-                for ci in range(ti.max(i - nb, 0), ti.min(i + nb, cfg.nx - 1)):
-                    for cj in range(ti.max(j - nb, 0), ti.min(j + nb, cfg.ny - 1)):
-                        for s in range(seg.count[ci, cj]):
-                            sg = seg.ends[ci, cj]
-                            a = ti.Vector([sg[4 * s], sg[4 * s + 1]])
-                            b = ti.Vector([sg[4 * s + 2], sg[4 * s + 3]])
-                            d2 = ti.min(d2, _seg_dist2(x, a, b))
-                out = sgn * ti.sqrt(d2)
+        sgn = 1.0 if f >= 0.0 else -1.0
+        out = sgn * cfg.phi_cap
+        if f < cfg.phi_cap:
+            x = ti.cast(ti.Vector([i, j]) - cfg.off, float) * cfg.h
+            d2 = cfg.phi_cap * cfg.phi_cap
+            for ci in range(ti.max(i - nb, 0), ti.min(i + nb, cfg.nx - 1)):
+                for cj in range(ti.max(j - nb, 0), ti.min(j + nb, cfg.ny - 1)):
+                    for s in range(seg.count[ci, cj]):
+                        sg = seg.ends[ci, cj]
+                        a = ti.Vector([sg[4 * s], sg[4 * s + 1]])
+                        b = ti.Vector([sg[4 * s + 2], sg[4 * s + 3]])
+                        d2 = ti.min(d2, _seg_dist2(x, a, b))
+            out = sgn * ti.sqrt(d2)
         nd.phi[i, j] = out
 
 

@@ -95,7 +95,6 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
                 amplitude_W_m3=amp,
                 spot_radius_m=r0,
                 penetration_depth_m=eta,
-                depth_sign=1.0 if las.depth_sign == "decay" else -1.0,
                 across=1.0 if las.scan == "across" else 0.0,
                 tracks=float(las.tracks),
                 hatch_m=las.hatch_um * 1e-6,

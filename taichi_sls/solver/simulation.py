@@ -10,7 +10,7 @@ import numpy as np
 
 from taichi_sls.backend import ti
 
-from .. import front_end
+from .. import taichi_patches
 from ..config import Case
 from ..physics.materials import KELVIN
 from . import checkpoint, compile_clock, struct_copy
@@ -53,7 +53,7 @@ def init_taichi(
     seconds instead of about 100 s and runs about 1.1-1.5x slower. ``fast_math=False``: strict
     IEEE arithmetic (the compiler may not reorder sums), so that a change of code structure that
     keeps every formula keeps every result bit for bit."""
-    front_end.install(ti)
+    taichi_patches.install(ti)  # Taichi's front end memoized (taichi_patches/front_end.py)
     ti.init(
         arch=ti.cpu if arch == "cpu" else ti.gpu,
         default_fp=ti.f64 if precision == "f64" else ti.f32,

@@ -119,7 +119,6 @@ class StepConfig:
     gamma_ramp_s: float  # gamma rises linearly over this time (0: at once)
     r_p: float
     band: int
-    redistance: bool
     phi_cap: float
     blur_passes: int
     smooth_passes: int
@@ -305,7 +304,6 @@ def step_config(
         gamma=first.surface_tension_N_m,
         r_p=st.point_radius_over_h * h,
         band=st.band_cells,
-        redistance=st.level_set == "redistanced",
         phi_cap=(st.band_cells + 1) * h,
         blur_passes=st.level_set_smoothing_passes,
         smooth_passes=st.smoothing_passes,

@@ -167,7 +167,7 @@ def run_one(
             c = load_case(case, [*own, *sets, *_step_scaling(c, f)])
         s = complete_summary(folder, DONE)
         toml = folder / "case.toml"
-        if s is not None and (not toml.is_file() or toml.read_text() != case_to_toml(c)):
+        if s is not None and (not toml.is_file() or toml.read_text() != case_to_toml(c.given or c)):
             print(f"{folder}: its case.toml differs from this study's: run again", file=sys.stderr)
             s = None
         if s is None:

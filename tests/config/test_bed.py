@@ -133,7 +133,7 @@ def test_bed_becomes_disc_bodies_and_the_domain_fits_it():
     top = max(b.center_um[1] + b.radius_um for b in case.bodies)
     assert case.domain.width_um == 400.0
     assert top < case.domain.height_um <= top + 2 * 40.0 + 4.0
-    rep = case.bed_report()
+    rep = case.bed_report
     assert rep["discs"] == 30 and rep["contacts"] >= 30 and 0.6 < rep["envelope"] < 0.91
     # the resolved case lists the discs and no bed: it loads back to the same case
     data = case_to_dict(case)
@@ -172,7 +172,7 @@ def test_generated_contacts_are_the_solver_contacts():
 
 def test_bundled_bed_track():
     case = load_case(bundled_case("bed_track"))
-    rep = case.bed_report()
+    rep = case.bed_report
     assert 50 <= rep["discs"] <= 100 and case.contact.initial == "fillet"
     assert 500 <= case.domain.width_um <= 1000 and case.lasers[0].speed_m_s > 0
     # two to three particles deep
@@ -200,7 +200,7 @@ def test_csv_bed_takes_a_generated_layer_on_top(tmp_path):
         {"csv": str(tmp_path / "bed.csv"), "count": 4, "median_diameter_um": 20.0},
         domain={"width_um": 80.0, "height_um": 120.0},
     )
-    assert len(case.bodies) == 7 and "csv bed.csv + deposition of 4" in case.bed_report()["source"]
+    assert len(case.bodies) == 7 and "csv bed.csv + deposition of 4" in case.bed_report["source"]
 
 
 CSV_BAD = [

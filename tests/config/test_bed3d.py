@@ -152,7 +152,7 @@ def test_a_3d_bed_becomes_sphere_bodies_and_the_domain_fits_it():
     assert case.domain.width_um == 80.0 and case.domain.depth_um == 80.0
     assert top < case.domain.height_um <= top + 2 * 20.0 + 5.0
     assert np.all(c[:, [0, 2]] - r[:, None] >= -1e-9) and np.all(c[:, [0, 2]] + r[:, None] <= 80)
-    rep = case.bed_report()
+    rep = case.bed_report
     assert rep["spheres"] == 25 and rep["contacts"] >= 25 and rep["source"].startswith("dep")
     # the resolved case lists the spheres and no bed: it loads back to the same case
     data = case_to_dict(case)
@@ -177,7 +177,7 @@ def test_a_csv_of_spheres_and_spheres_deposited_on_it(tmp_path):
         "20,10,20,10\n40,10,20,10\n30,27.320508075688775,20,10\n"
     )
     case = _case({"csv": str(path)}, domain={"dim": 3, "width_um": 60.0, "height_um": 60.0})
-    assert len(case.bodies) == 3 and case.bed_report()["contacts"] == 3
+    assert len(case.bodies) == 3 and case.bed_report["contacts"] == 3
     more = _case(
         {"csv": str(path), "count": 10, "median_diameter_um": 15.0},
         domain={"dim": 3, "width_um": 60.0, "height_um": 100.0},
@@ -243,6 +243,6 @@ def test_the_gpu_layer_case_loads():
     from taichi_sls.config import load_case
 
     case = load_case(ROOT_CASES / "bed3d_hatch_gpu.toml")
-    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report()["spheres"] == 400
+    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report["spheres"] == 400
     assert case.grid.spacing_um == 2.0
     assert case.lasers[0].tracks == 3 and case.lasers[0].hatch_um == 80.0

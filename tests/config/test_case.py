@@ -237,3 +237,24 @@ def test_cli_missing_file_is_one_line(tmp_path, capsys):
     assert run_main([str(tmp_path / "nope.toml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"error: case file {str(tmp_path / 'nope.toml')!r} does not exist"]
+
+
+@pytest.mark.parametrize(
+    "override, message",
+    [
+        (
+            "surface_tension.surface_energy_colour=volume",
+            "surface_tension.surface_energy_colour = 'volume': allowed values are mass",
+        ),
+        (
+            "surface_tension.level_set=raw",
+            "surface_tension.level_set = 'raw': allowed values are redistanced",
+        ),
+        ("lasers.0.depth_sign=paper", "lasers[0].depth_sign = 'paper': allowed values are decay"),
+    ],
+)
+def test_a_removed_switch_is_refused_by_its_key_with_what_is_allowed(override, message):
+    """Switches no case, sweep, study or test used (#52): their one reading left."""
+    with pytest.raises(CaseError) as e:
+        load_case("power25W", [override])
+    assert str(e.value).endswith(message) and "\n" not in str(e.value)

@@ -68,7 +68,7 @@ def test_new_discs_rest_on_the_layer_points(tmp_path):
     rests = (gap.min(axis=1) < 1e-6) | (pair_gap.min(axis=1) < 1e-6)
     assert rests.all()
     assert case.domain.height_um >= (discs[:, 1] + discs[:, 2]).max()
-    rep = case.bed_report()
+    rep = case.bed_report
     assert rep["previous_layer_bodies"] == 3 and rep["previous_layer_points"] == len(x)
     assert np.isnan(rep["envelope"])  # the layer below is not void
 

@@ -72,7 +72,7 @@ def test_new_spheres_rest_on_the_3d_layer(tmp_path):
     assert ((gap.min(axis=1) < 1e-6) | (pair.min(axis=1) < 1e-6)).all()
     assert (s[:, 1] - s[:, 3]).min() > 7.0  # on the slab, not the plate
     assert case.domain.height_um >= (s[:, 1] + s[:, 3]).max()
-    rep = case.bed_report()
+    rep = case.bed_report
     assert rep["previous_layer_bodies"] == 2 and rep["previous_layer_points"] == len(x)
     assert np.isnan(rep["envelope"])
 

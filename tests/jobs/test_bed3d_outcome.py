@@ -46,7 +46,7 @@ TINY_BED3D = {
 
 def test_a_tiny_3d_bed_reports_its_contacts_density_and_fused_count(tmp_path):
     case = make_case(TINY_BED3D)
-    generated = case.bed_report()
+    generated = case.bed_report
     s = run_case(case, tmp_path, progress=False)
     bed = s["bed"]
     print(bed)
@@ -66,6 +66,6 @@ def test_a_tiny_3d_bed_reports_its_contacts_density_and_fused_count(tmp_path):
 
 def test_the_bundled_3d_track_case_loads():
     case = load_case(ROOT / "cases" / "bed3d_track.toml")
-    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report()["spheres"] == 48
+    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report["spheres"] == 48
     assert case.time.integrator == "hybrid" and case.time.stop == "solidified"
     assert case.lasers[0].direction == "x" and case.contact.initial == "fillet"

@@ -99,7 +99,7 @@ def test_density_before_is_the_beds_packing_and_the_melt_densifies(runs):
     it lies within [envelope, envelope + 0.04]. Heated, the layer sinks and densifies."""
     case, folder = runs["laser"]
     d = _bed(folder)["relative_density"]
-    assert d["generator_envelope"] == pytest.approx(case.bed_report()["envelope"])
+    assert d["generator_envelope"] == pytest.approx(case.bed_report["envelope"])
     assert d["generator_envelope"] <= d["initial"] <= d["generator_envelope"] + 0.04
     assert d["final"] > d["initial"] and d["mean_top_final_um"] < d["mean_top_initial_um"]
     dark = _bed(runs["dark"][1])["relative_density"]
@@ -268,3 +268,16 @@ def test_the_bed_printout_reads_a_summary_back_from_json():
     lines = describe_bed(json.loads(text)).splitlines()
     assert lines[0] == "bed: 0 contacts, 0 fused (-), 0 melted through, 0 still molten"
     assert "bulk -" in lines[2] and "down to - above the plate" in lines[3]
+
+
+def test_a_bed_run_writes_its_case_as_given_and_as_resolved(runs):
+    """case.toml: the case as given, its [bed] a table (it loads back to the same case);
+    resolved.toml: what ran, every disc a body and no [bed] (config/resolve.py)."""
+    from taichi_sls.config import case_to_toml, load_case
+
+    case, folder = runs["laser"]
+    given = load_case(folder / "case.toml")
+    assert given == case and "[bed]" in (folder / "case.toml").read_text()
+    resolved = (folder / "resolved.toml").read_text()
+    assert resolved == case_to_toml(case) and "[bed]" not in resolved
+    assert resolved.count("[[bodies]]") == len(DISCS)

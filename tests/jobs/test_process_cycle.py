@@ -30,7 +30,7 @@ def test_machine_layer3d_is_the_machine_cycle_on_spheres():
     hatched in the bed plane (two tracks along x, 0.1 mm apart), contacts settled."""
     case, flat = load_case("machine_layer3d"), load_case("machine_layer")
     las, las_2d = case.lasers[0], flat.lasers[0]
-    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report()["spheres"] == 48
+    assert case.domain.dim == 3 and len(case.bodies) == case.bed_report["spheres"] == 48
     assert las.direction == "x" and las.tracks == 2 and las.hatch_um == las_2d.hatch_um
     assert (las.power_W, las.speed_m_s) == (las_2d.power_W, las_2d.speed_m_s)
     for key in ("initial_C", "top_surface", "chamber_C", "emissivity", "convection_W_m2K"):

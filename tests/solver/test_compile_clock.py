@@ -3,10 +3,10 @@ error excerpts."""
 
 import pytest
 
-from taichi_sls import front_end
 from taichi_sls.backend import ti
 from taichi_sls.solver import compile_clock
 from taichi_sls.solver.simulation import init_taichi
+from taichi_sls.taichi_patches import front_end
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -51,7 +51,7 @@ def test_a_new_template_instance_counts_as_a_new_kernel():
 
 
 def test_the_front_end_cache_keeps_taichis_error_excerpts():
-    assert front_end.install(ti)  # installed on import; installing again is a no-op
+    assert front_end.install(ti)  # installed by init_taichi; installing again is a no-op
 
     @ti.kernel
     def broken():
@@ -133,3 +133,22 @@ def test_the_fast_class_check_answers_as_taichis():
     assert len(answers) >= 5
     assert all(ours == theirs for ours, theirs in answers), answers
     assert {ours for ours, _ in answers} == {True, False}
+
+
+def test_importing_the_solver_patches_nothing_and_init_taichi_installs_the_patches():
+    """Taichi's private front end is patched by an explicit call only (taichi_patches.install,
+    from init_taichi), never by an import."""
+    import subprocess
+    import sys
+
+    code = (
+        "import taichi_sls.solver.simulation as s\n"
+        "from taichi_sls.backend import ti\n"
+        "k = ti.lang.kernel_impl\n"
+        "patched = lambda: getattr(k._inside_class, '_sls_memo', False)\n"
+        "assert not patched(), 'patched on import'\n"
+        "s.init_taichi()\n"
+        "assert patched(), 'not patched by init_taichi'\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-2000:]

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ...config import Bed, Case, load_case
-from ...config.loading import apply_override, find_case, read_toml
+from ...config.loading import apply_override, find_case, read_case_file
 from ..sweep.spec import Sweep, SweepCase, SweepError, case_id, toml_value
 
 DEFAULT_BASE = "cases/machine_layer.toml"
@@ -91,7 +91,7 @@ def andrew_J_mm2(power_W: float, speed_m_s: float, hatch_um: float) -> float:
 def load_base(base: str | Path, extra_set: Sequence[str] = ()) -> tuple[Case, Bed]:
     """The base case with ``extra_set`` and its [bed] table (the loaded case has made the bed's
     discs bodies); refused unless its first laser scans hatches across a generated bed."""
-    data = read_toml(find_case(base), "case")
+    data = read_case_file(find_case(base))
     for text in extra_set:
         apply_override(data, text)
     lasers = data.get("lasers") or [{}]

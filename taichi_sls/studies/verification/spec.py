@@ -22,7 +22,7 @@ from pydantic import Field, ValidationError
 
 from ...config import Case, CaseError, bundled_cases, case_from_dict, deep_update, read_toml
 from ...config.errors import case_error
-from ...config.loading import bundled_root, find_case, in_file, resolve_files
+from ...config.loading import bundled_root, find_case, in_file, read_case_file, resolve_files
 from ...config.model import Model, Pair
 from .. import references as ref
 from .geometry import bar_geometry, disc_geometry, hopper_geometry, slab_length
@@ -183,7 +183,7 @@ def load_file(path: str | Path, overrides: list[str] | None = None) -> Verificat
     from ...config.loading import apply_override
 
     path = find_case(path)
-    data = read_toml(path, "case file")
+    data = read_case_file(path)
     for o in overrides or []:
         apply_override(data, o)
     data.setdefault("case", {}).setdefault("name", path.stem)

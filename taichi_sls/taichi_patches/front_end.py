@@ -87,7 +87,8 @@ def _memo_sources(ti: Any) -> bool:
 
 def install(ti: Any) -> bool:
     """Memoize the front end's sources and source excerpts of the Taichi module ``ti`` (once per
-    process; taichi_sls.backend installs them on import). False where none was applied."""
+    process: installing again changes nothing; init_taichi calls it). False where none was
+    applied."""
     if os.environ.get(ENV, "1") == "0":
         return False
     sources = _memo_sources(ti)
