@@ -13,8 +13,7 @@ from typing import Any
 import numpy as np
 from pydantic import Field, PrivateAttr, model_validator
 
-from .bed import Bed, bed_discs
-from .bed3d import expand_bed_3d
+from .bed import Bed, expand_bed
 from .bodies import EXTRUDED, Body, Disc, LayerBody
 from .dim import check_dimension, default_laser_depths, unset_laser_depths
 from .errors import CaseError
@@ -85,55 +84,10 @@ class Case(Model):
         return data
 
     def _expand_bed(self) -> None:
-        """The [bed]'s discs become bodies after the [[bodies]], and the table goes (the resolved
-        case lists the discs, so it loads back to the same bed). An unset domain width or height
-        is fitted to the bed: its x range, and its top plus one mean diameter, in whole cells."""
-        bed = self.bed
-        if bed is None:
-            return
-        if self.domain.dim == 3:
-            expand_bed_3d(self, self._previous_layer(bed))
-            return
-        if bed.material not in self.materials:
-            raise CaseError(
-                f"bed.material = {bed.material!r}: no such material; defined: "
-                f"{', '.join(self.materials)}"
-            )
-        given = self.domain.model_fields_set
-        W = self.domain.width_um if "width_um" in given else None
-        H = self.domain.height_um if "height_um" in given else None
-        old = [[*b.center_um, b.radius_um] for b in self.bodies if b.shape == "disc"]
-        old = np.array(old, dtype=float).reshape(-1, 3)
-        below = self._previous_layer(bed)
-        if below:  # the new discs land on the layer's points, each a disc in its square
-            layer = read_layer(bed.previous_layer)
-            old = np.concatenate([old, layer.balls_um()])
-        join = 2.0 * self.contact.fillet_radius_um if self.contact.initial == "fillet" else 0.0
-        discs = bed_discs(bed, old, W, H, join)
-        if below:
-            discs.report.update(layer.bed_report(bed.previous_layer))
-        h = self.grid.spacing_um
-        if W is None:
-            right = max(discs.report["x_range_um"][1], float(np.max(discs.x + discs.r)))
-            self.domain.width_um = h * math.ceil(right / h - 1e-9)
-        if H is None:
-            top = float(np.max(discs.y + discs.r)) + 2.0 * float(np.mean(discs.r))
-            self.domain.height_um = h * math.ceil(top / h - 1e-9)
-        self.bodies = [
-            *self.bodies,
-            *below,
-            *(
-                Disc(
-                    center_um=[float(x), float(y)],
-                    radius_um=float(r),
-                    material=bed.material,
-                    temperature_C=bed.temperature_C,
-                )
-                for x, y, r in zip(discs.x, discs.y, discs.r, strict=True)
-            ),
-        ]
-        self.bed = None
-        self._bed_report = discs.report
+        """The [bed]'s particles become bodies after the [[bodies]], and the table goes
+        (config/bed.py, ``expand_bed``)."""
+        if self.bed is not None:
+            expand_bed(self, self._previous_layer(self.bed))
 
     def _previous_layer(self, bed: Bed) -> list[LayerBody]:
         """The bodies of ``bed.previous_layer`` (none without one), checked against the case:

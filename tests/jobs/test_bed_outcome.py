@@ -188,12 +188,12 @@ def test_relative_density_of_a_block_with_a_hole():
     h, off = 1.0, 2
     c = np.zeros((44, 30))
     c[off : off + 41, : off + 11] = 1.0  # x 0..40, y up to 10 (+ h/2 to the crossing)
-    full = relative_density(c, h, off, (0.0, 40.0), 28.0)
+    full = relative_density(c, h, off, [(0.0, 40.0)], 28.0)
     assert full["relative_density"] == pytest.approx(1.0)
     assert full["mean_top_m"] == pytest.approx(10.5, abs=0.13)
     # nodes x 10..13, y 3..6 empty: c < 1/2 from half a cell before them to half after, 4 x 4
     c[off + 10 : off + 14, off + 3 : off + 7] = 0.0
-    holed = relative_density(c, h, off, (0.0, 40.0), 28.0)
+    holed = relative_density(c, h, off, [(0.0, 40.0)], 28.0)
     assert holed["relative_density"] == pytest.approx(1.0 - 16.0 / (40.0 * 10.5), abs=0.005)
 
 
