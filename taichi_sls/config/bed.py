@@ -311,12 +311,13 @@ def bed_particles(
     return BedParticles(c, r, {**report, **packing_fractions(c, r, box)})
 
 
-def expand_bed(case: Any, below: list) -> None:
+def expand_bed(case: Any, below: list) -> dict:
     """Replace ``case.bed`` by its particles, appended to ``case.bodies`` (the resolved case
     lists them and loads back to the same bed); an unset domain width, height (or depth) is
     fitted to the bed (its lateral ranges; its top plus one mean diameter), in whole cells.
     ``below``: the bodies of ``bed.previous_layer`` (LayerBody), listed before the new
-    particles, which land on its points (each a disc in its square, a sphere in its cube)."""
+    particles, which land on its points (each a disc in its square, a sphere in its cube).
+    Returns the bed's report (source, count, contacts, packing fractions, mean top)."""
     bed: Bed = case.bed
     if bed.material not in case.materials:
         raise CaseError(
@@ -359,4 +360,4 @@ def expand_bed(case: Any, below: list) -> None:
     )
     case.bodies = [*case.bodies, *below, *new]
     case.bed = None
-    case._bed_report = report
+    return report

@@ -87,7 +87,7 @@ class Case(Model):
         """The [bed]'s particles become bodies after the [[bodies]], and the table goes
         (config/bed.py, ``expand_bed``)."""
         if self.bed is not None:
-            expand_bed(self, self._previous_layer(self.bed))
+            self._bed_report = expand_bed(self, self._previous_layer(self.bed))
 
     def _previous_layer(self, bed: Bed) -> list[LayerBody]:
         """The bodies of ``bed.previous_layer`` (none without one), checked against the case:
