@@ -1,5 +1,6 @@
-"""``python -m taichi_sls.bench STUDY ...``: the benchmarks and studies (``taichi-sls bench``:
-speed, cost, accuracy, paper, neck, refinement; see :mod:`taichi_sls.cli`)."""
+"""``python -m taichi_sls.bench NAME ...`` is ``taichi-sls bench NAME ...``: a study from the
+package (hold, window, refinement, process) or a developer's benchmark, bench/NAME.py in a
+checkout of the repository (see :mod:`taichi_sls.cli`)."""
 
 import sys
 

@@ -2,27 +2,25 @@
 
     run CASE         run a case file (or a bundled case by name) with every output
     sweep SWEEP      a parameter sweep on Dask
-    bench STUDY      speed, compile (each bundled case's, cold and warm), cost, implicit (both
-                     integrators side by side), hold (a melt that
-                     sinters for a second, against Hopper), accuracy, paper (the Table 2 cases),
-                     neck (the melted-pair study), refinement (the paper's cases under grid and
-                     dt refinement), packing3d (the 3D bed generator's packing fraction),
-                     process (a PA12 layer's density against energy density and bed
-                     temperature, and its sensitivities), symmetry (a 3D pair's quarter under
-                     two mirror walls against the full domain), speed3d (explicit 3D throughput)
-    robustness       the stress matrix of cases at the edge of stability
+    bench NAME       a study a user runs (hold, window, refinement, process), or a developer's
+                     benchmark: bench/NAME.py in a checkout of the repository (speed, compile,
+                     cost, accuracy, robustness, ...; ``taichi-sls bench --help`` lists them)
     case             print the case-file reference (docs/case_reference.md)
 
+Every subcommand but ``run`` and ``case`` is parsed by its own module, imported only when the
+subcommand is named: ``taichi-sls --help`` and ``taichi-sls case`` load neither Taichi nor Dask.
 ``python -m taichi_sls.run CASE ...`` is ``taichi-sls run CASE ...``; ``python -m taichi_sls.bench
-STUDY ...`` is ``taichi-sls bench STUDY ...``.
+NAME ...`` is ``taichi-sls bench NAME ...``.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import signal
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -136,62 +134,106 @@ def case_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def parser() -> argparse.ArgumentParser:
-    from .studies import (
-        accuracy,
-        bed3d_packing,
-        compile_bench,
-        cost_error,
-        implicit3d_bench,
-        implicit_bench,
-        neck_study,
-        pair_window,
-        paper,
-        refinement,
-        robustness,
-        sinter_hold,
-        speed,
-        speed3d,
-        sphere_pair,
-        symmetry,
-    )
-    from .studies.process import study as process_study
-    from .studies.sweep import runner as sweep
+# the studies a user runs, in the package: name -> (module, what it answers)
+STUDIES = {
+    "hold": ("taichi_sls.studies.sinter_hold", "a melt that sinters for a second, against Hopper"),
+    "window": ("taichi_sls.studies.pair_window", "a pair in the sintering window, against Hopper"),
+    "refinement": (
+        "taichi_sls.studies.refinement",
+        "the paper's cases under grid and dt refinement",
+    ),
+    "process": ("taichi_sls.studies.process.study", "a PA12 layer's density against the process"),
+}
+# the developer's benchmarks, bench/NAME.py in a checkout (not installed): what they measure
+BENCHMARKS = {
+    "speed": "cost per step against a minimal MLS-MPM step",
+    "speed3d": "explicit 3D point-steps per second and bytes per point",
+    "compile": "compile time of every bundled case, cold and warm",
+    "cost": "run time against error over dt, inertia scale and grid",
+    "implicit": "explicit and implicit integrators side by side",
+    "implicit3d": "the 3D implicit step's cost against its unknowns",
+    "accuracy": "verification cases against analytic solutions, by resolution",
+    "robustness": "cases at the edge of stability: stable, caught or WRONG",
+    "neck": "the melted pair under surface tension alone, by Poisson ratio",
+    "packing3d": "the 3D bed generator's packing fraction, per seed",
+    "symmetry": "a 3D pair's quarter under two mirror walls against the full domain",
+    "spherepair": "3D coalescence of two liquid spheres against Frenkel and Pokluda",
+}
 
-    ap = argparse.ArgumentParser(
+
+def bench_root() -> Path | None:
+    """The checkout whose ``bench/`` holds the benchmarks: the one this package is installed
+    from (``pip install -e .``), else the working folder; None for an installed package."""
+    for root in (Path(__file__).resolve().parents[1], Path.cwd()):
+        if (root / "bench" / "__init__.py").is_file():
+            return root
+    return None
+
+
+def _bench_module(name: str) -> Any:
+    """Import the module of ``bench NAME``: a study from the package, or bench/NAME.py."""
+    if name in STUDIES:
+        return importlib.import_module(STUDIES[name][0])
+    root = bench_root()
+    if root is None:
+        raise CaseError(
+            f"bench {name}: a developer's benchmark, bench/{name}.py in a checkout of the "
+            f"repository (run it there after pip install -e .); this installed package "
+            f"({Path(__file__).parent}) has no bench/ beside it"
+        )
+    if str(root) not in sys.path:
+        sys.path.insert(0, str(root))
+    return importlib.import_module(f"bench.{name}")
+
+
+class _Parser(argparse.ArgumentParser):
+    """The top-level parser: a lazy subcommand (``sweep``, ``bench NAME``) is parsed in full by
+    the parser its module adds, the module imported only then; the rest parse here."""
+
+    def parse_known_args(
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        argv = sys.argv[1:] if args is None else list(args)
+        if argv[:1] == ["sweep"]:
+            command, name, module = "sweep", "sweep", "taichi_sls.studies.sweep.runner"
+        elif argv[:1] == ["bench"] and argv[1:2] and argv[1] in (*STUDIES, *BENCHMARKS):
+            command, name, module = "bench", argv[1], None
+        else:
+            return super().parse_known_args(argv, namespace)
+        try:
+            loaded = importlib.import_module(module) if module else _bench_module(name)
+        except CaseError as e:
+            self.error(str(e))
+        ap = argparse.ArgumentParser(prog=self.prog if module else f"{self.prog} bench")
+        loaded.add_parser(ap.add_subparsers(dest="name", required=True))
+        start = 1 if module else 2
+        return ap.parse_known_args([name, *argv[start:]], argparse.Namespace(command=command))
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = _Parser(
         prog="taichi-sls", description="Particle-scale MPM simulation of selective laser sintering."
     )
-    sub = ap.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
+    sub = ap.add_subparsers(
+        dest="command", required=True, metavar="SUBCOMMAND", parser_class=argparse.ArgumentParser
+    )
     p = sub.add_parser("run", help="run a case with every output")
     add_run_arguments(p)
     p.set_defaults(func=run_command)
-    sweep.add_parser(sub)
-    bench = sub.add_parser(
+    # sweep and bench NAME: listed here, parsed by _Parser with their modules' parsers
+    sub.add_parser("sweep", help="a parameter sweep on Dask (SWEEP.toml)")
+    listing = [f"  {n:<11} {h}" for n, (_, h) in STUDIES.items()]
+    listing += ["", "developer's benchmarks (bench/NAME.py in a checkout of the repository):"]
+    listing += [f"  {n:<11} {h}" for n, h in BENCHMARKS.items()]
+    p = sub.add_parser(
         "bench",
-        help="benchmarks and studies: speed, compile, cost, implicit, implicit3d, hold, window, "
-        "accuracy, paper, neck, refinement, packing3d, process, symmetry, speed3d, spherepair",
+        help="studies (hold, window, refinement, process) and benchmarks (bench/ in a checkout)",
+        description="A study, or a developer's benchmark; taichi-sls bench NAME --help for its "
+        "options.",
+        epilog="studies:\n" + "\n".join(listing),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    studies = bench.add_subparsers(dest="study", required=True, metavar="STUDY")
-    for module in (
-        speed,
-        compile_bench,
-        cost_error,
-        implicit_bench,
-        implicit3d_bench,
-        sinter_hold,
-        pair_window,
-        accuracy,
-        paper,
-        neck_study,
-        refinement,
-        bed3d_packing,
-        process_study,
-        symmetry,
-        speed3d,
-        sphere_pair,
-    ):
-        module.add_parser(studies)
-    robustness.add_parser(sub)
+    p.add_argument("study", choices=[*STUDIES, *BENCHMARKS], metavar="NAME")
     p = sub.add_parser("case", help="print the case-file reference (every key, default, unit)")
     p.add_argument("--write", metavar="FILE", help="write it to FILE instead")
     p.set_defaults(func=case_command)

@@ -1,6 +1,6 @@
 """Mirror walls (``boundary.<side>.mechanical = "mirror"``, physics/mirror.py): a sphere pair
 under a centred beam run as a quarter (mirrors at x = W/2 and z = D/2) gives the full domain's
-neck and peak temperature (studies/symmetry.py). The mirror is exact up to rounding (the folded
+neck and peak temperature (bench/symmetry.py). The mirror is exact up to rounding (the folded
 sums add in another order than the full run's), so the default suite holds the quarter to
 1e-6 of the full run at R/h = 4 (measured ~1e-9; a surface cut that is not mirror symmetric,
 Kuhn's tetrahedra in every cube, is 4e-4 off within 24 steps). The slow test is the issue's
@@ -10,9 +10,9 @@ the mirror on the right or the left wall."""
 import numpy as np
 import pytest
 
+from bench import symmetry
 from taichi_sls.config import CaseError
 from taichi_sls.config.loading import case_from_dict, case_to_dict
-from taichi_sls.studies import symmetry
 
 ROUNDING = 1e-6  # the quarter is the full run's mirror image up to round-off
 

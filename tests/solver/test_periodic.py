@@ -1,14 +1,19 @@
 """A periodic depth (3D, boundary.front / back mechanical = "periodic"; solver/periodic.py) and
 the cylinder body: refused where they cannot run, and the wrap exact where they can."""
 
+import tomllib
+
 import numpy as np
 import pytest
 from helpers import make_case
 
-from taichi_sls.config import CaseError
+from taichi_sls.config import CaseError, bundled_case
 from taichi_sls.solver.scene import build_scene
 from taichi_sls.solver.simulation import Simulation
-from taichi_sls.studies.sphere_pair import FLUID
+
+# Hopper's viscous liquid (cases/verification/hopper.toml), its one material table
+with open(bundled_case("verification/hopper"), "rb") as f:
+    FLUID = dict(tomllib.load(f)["materials"]["fluid"])
 
 PERIODIC = {"front": {"mechanical": "periodic"}, "back": {"mechanical": "periodic"}}
 SIDES = ("left", "right", "bottom", "top")

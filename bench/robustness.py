@@ -1,4 +1,4 @@
-"""The robustness matrix: ``taichi-sls robustness [--quick] [--out out/robustness]``.
+"""The robustness matrix: ``taichi-sls bench robustness [--quick] [--out out/robustness]``.
 
 Runs a matrix of cases at the edge of stability -- time step from 0.25x to 4x the automatic
 limit, laser power 1 to 100 W, grid spacing 4 to 0.5 um, 10 ms and 40 ms runs, inertia scales
@@ -24,11 +24,11 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..config import Case, Rect, bundled_case, load_case
-from ..physics.materials import KELVIN
-from ..solver.guard import SimulationError
-from ..solver.simulation import Simulation
-from ..solver.time_step import time_step_limits
+from taichi_sls.config import Case, Rect, bundled_case, load_case
+from taichi_sls.physics.materials import KELVIN
+from taichi_sls.solver.guard import SimulationError
+from taichi_sls.solver.simulation import Simulation
+from taichi_sls.solver.time_step import time_step_limits
 
 
 @dataclass

@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from . import verification as ver
-from .verification.common import transfer_label
+from taichi_sls.studies import verification as ver
+from taichi_sls.studies.verification.common import transfer_label
 
 # point-level cases: their resolution is the time step, not the grid
 POINT_LEVEL = ("perzyna", "finite_strain")

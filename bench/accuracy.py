@@ -1,6 +1,6 @@
 """The accuracy study: ``taichi-sls bench accuracy [--quick] [--out DIR]``.
 
-Runs every verification case (:mod:`taichi_sls.verification`) at three or more resolutions,
+Runs every verification case (:mod:`taichi_sls.studies.verification`) at three or more resolutions,
 the transfers (APIC, FLIP, PIC/FLIP 0.9) where they differ and f32 against f64, and writes
 ``accuracy.csv`` (case, kind, resolution, h_um, dt_s, measure, error, wall_s, steps, transfer,
 precision) and the plots ``accuracy_convergence.png`` (error against h, observed order),
@@ -19,9 +19,9 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..config import bundled_case, deep_update
-from . import verification as ver
-from .verification.common import transfer_label
+from taichi_sls.config import bundled_case, deep_update
+from taichi_sls.studies import verification as ver
+from taichi_sls.studies.verification.common import transfer_label
 
 COLUMNS = (
     "case",
@@ -265,9 +265,9 @@ PAPER_COLUMNS = ("h_um", "dt_s", "steps", "contact_line_um", "T_peak_C", "wall_s
 def run_paper(spacings: list[float], out: Path, end_s: float = 1e-3) -> list[dict]:
     """cases/power25W.toml at each spacing, dt = 2.5e-8 s per um of h (the paper's 5e-8 s at
     h = 2 um, scaled with the elastic limit), to ``end_s``: contact line and peak temperature."""
-    from ..config import load_case
-    from ..solver.guard import SimulationError
-    from ..solver.simulation import Simulation
+    from taichi_sls.config import load_case
+    from taichi_sls.solver.guard import SimulationError
+    from taichi_sls.solver.simulation import Simulation
 
     out.mkdir(parents=True, exist_ok=True)
     path = out / "paper_refinement.csv"
@@ -331,7 +331,7 @@ def main(args: argparse.Namespace) -> int:
     if args.paper is not None:
         run_paper(args.paper or [4.0, 2.0, 1.0], out)
         return 0
-    from .accuracy_plots import plot, summary_table
+    from bench.accuracy_plots import plot, summary_table
 
     t0 = time.perf_counter()
     rows = run_study(args.quick, out, args.only)

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config.deposition import deposit, lognormal_diameters
-from ..config.packing import packing_fractions, slab_volume
-from ..io.atomic import atomic_path
+from taichi_sls.config.deposition import deposit, lognormal_diameters
+from taichi_sls.config.packing import packing_fractions, slab_volume
+from taichi_sls.io.atomic import atomic_path
 
 VISSCHER_BOLSTERLI = 0.58  # Nature 239, 504 (1972): sequential deposition with rolling, 3D
 RLP, RCP = 0.55, 0.64  # random loose and random close packing of equal spheres

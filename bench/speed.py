@@ -18,15 +18,21 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.baseline import MinimalMPM
 from taichi_sls.backend import ti
-
-from ..config import Case, apply_override, bundled_case, case_from_dict, case_to_dict, load_case
-from ..config.loading import add_set_argument
-from ..solver.fields import State
-from ..solver.scene import build_scene
-from ..solver.simulation import Simulation
-from ..solver.step import advance, advance_staged
-from .baseline import MinimalMPM
+from taichi_sls.config import (
+    Case,
+    apply_override,
+    bundled_case,
+    case_from_dict,
+    case_to_dict,
+    load_case,
+)
+from taichi_sls.config.loading import add_set_argument
+from taichi_sls.solver.fields import State
+from taichi_sls.solver.scene import build_scene
+from taichi_sls.solver.simulation import Simulation
+from taichi_sls.solver.step import advance, advance_staged
 
 PAPER_CASE = bundled_case("power25W")
 

@@ -1,6 +1,6 @@
-"""studies/sphere_pair.py: two liquid spheres coalescing in 3D (no heat). A short look at
+"""bench/spherepair.py: two liquid spheres coalescing in 3D (no heat). A short look at
 R/h = 4 (25 s: slow): the neck grows from the seeded contact and the volume is kept; the
-octant under mirrors runs the whole pair; the models and the report (studies/
+octant under mirrors runs the whole pair; the models and the report (bench/
 sphere_pair_report.py). The study's figures are in docs/verification.md."""
 
 import math
@@ -8,10 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from taichi_sls.io.atomic import write_rows
-from taichi_sls.solver.simulation import Simulation
-from taichi_sls.studies.sphere_pair import coalesce, pair_measures, sphere_pair_case
-from taichi_sls.studies.sphere_pair_report import (
+from bench.sphere_pair_report import (
     END_STATE,
     convergence,
     frenkel_neck,
@@ -19,6 +16,9 @@ from taichi_sls.studies.sphere_pair_report import (
     pokluda_neck,
     report_main,
 )
+from bench.spherepair import coalesce, pair_measures, sphere_pair_case
+from taichi_sls.io.atomic import write_rows
+from taichi_sls.solver.simulation import Simulation
 
 
 @pytest.mark.slow
@@ -56,7 +56,7 @@ def test_the_octant_runs_the_whole_pair():
 
 
 def test_pokluda_reaches_one_sphere_and_starts_as_its_small_angle_law():
-    """Pokluda et al.'s model (studies/sphere_pair_report.py): from a tiny neck its (x/R)^2 / tau
+    """Pokluda et al.'s model (bench/sphere_pair_report.py): from a tiny neck its (x/R)^2 / tau
     is 1 (its small-angle limit, to 1 %: the start x0 = 1e-3 still counts at tau = 1e-4); it
     rises monotonically and stays below one sphere's 2^(1/3), within 1 % of it by tau = 10."""
     tau = np.array([1e-3, 1e-2, 0.1, 1.0, 3.0, 10.0])

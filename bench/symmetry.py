@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import Case
-from ..config.loading import case_from_dict
-from ..io.atomic import atomic_write_text, write_rows
+from taichi_sls.config import Case
+from taichi_sls.config.loading import case_from_dict
+from taichi_sls.io.atomic import atomic_write_text, write_rows
 
 RADIUS_UM = 16.0
 POWER_W = 0.3  # the beam melts the pair's contact within the run
@@ -85,7 +85,7 @@ def neck_um(x_um: np.ndarray, centre: tuple[float, float, float], h_um: float) -
 
 def run_series(case: Case, samples: int = SAMPLES) -> tuple[list[dict], float]:
     """(rows of t, neck and peak temperature at ``samples`` times to the end, stepping wall s)."""
-    from ..solver.simulation import Simulation
+    from taichi_sls.solver.simulation import Simulation
 
     sim = Simulation(case)
     W = case.domain.width_um * (1 if case.boundary.right.mechanical != "mirror" else 2)

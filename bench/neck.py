@@ -49,9 +49,9 @@ MONITORS = ("contact_line_um", "kinetic_energy_J_per_m", "J_min", "T_peak_C")
 
 def run_one(case_name: str, sets: list[str], end_s: float, every_s: float) -> list[dict]:
     """The monitors every ``every_s``; a run the guard stops ends with a row that says so."""
-    from ..config import load_case
-    from ..solver.guard import SimulationError
-    from ..solver.simulation import Simulation
+    from taichi_sls.config import load_case
+    from taichi_sls.solver.guard import SimulationError
+    from taichi_sls.solver.simulation import Simulation
 
     case = load_case(case_name, [*sets, f"time.end_s={end_s}"])
     sim = Simulation(case)

@@ -5,12 +5,12 @@ import csv
 import numpy as np
 import pytest
 
+from bench.baseline import MinimalMPM
+from bench.speed import layer_case
 from taichi_sls.backend import ti
 from taichi_sls.cli import main
 from taichi_sls.config import case_from_dict
 from taichi_sls.solver.scene import build_scene
-from taichi_sls.studies.baseline import MinimalMPM
-from taichi_sls.studies.speed import layer_case
 
 
 @pytest.mark.parametrize("n", [10_000, 100_000])
@@ -57,7 +57,7 @@ def test_cost_errors_are_relative_to_the_reference_row():
     """The run-time/error study: each paper row's errors are relative to the reference row's
     neck at 1 ms, final neck and peak temperature; its error is the largest of the three, and
     rows of other scenarios keep their own error."""
-    from taichi_sls.studies.cost_error import errors
+    from bench.cost import errors
 
     paper = "paper 25 W to solidification"
     rows = [

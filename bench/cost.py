@@ -26,8 +26,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..config import load_case
-from ..config.loading import add_set_argument
+from taichi_sls.config import load_case
+from taichi_sls.config.loading import add_set_argument
 
 IMPLICIT = ["time.integrator=implicit", "time.heat_integrator=implicit"]
 HYBRID = "time.integrator=hybrid"
@@ -92,8 +92,8 @@ COLUMNS = [
 
 
 def _paper_row(label: str, sets: list[str], out: Path) -> dict:
-    from ..io.series import read_series
-    from ..jobs.case_run import complete_summary, run_case
+    from taichi_sls.io.series import read_series
+    from taichi_sls.jobs.case_run import complete_summary, run_case
 
     sets = [
         *sets,
@@ -123,7 +123,7 @@ def _paper_row(label: str, sets: list[str], out: Path) -> dict:
 
 
 def _verification_rows(quick: bool) -> list[dict]:
-    from . import verification as ver
+    from taichi_sls.studies import verification as ver
 
     rows = []
     for name, res, measure, sets in (

@@ -32,10 +32,10 @@ import sys
 import time
 from pathlib import Path
 
-from ..config import load_case
-from ..jobs.case_run import complete_summary, run_case
-from ..solver.time_step import time_step_limits
-from . import verification as ver
+from taichi_sls.config import load_case
+from taichi_sls.jobs.case_run import complete_summary, run_case
+from taichi_sls.solver.time_step import time_step_limits
+from taichi_sls.studies import verification as ver
 
 IMPLICIT = {"integrator": "implicit"}
 COLUMNS = [

@@ -19,12 +19,11 @@ import math
 import time
 from pathlib import Path
 
+from bench.speed import build, field_bytes, peak_rss_mb
 from taichi_sls.backend import ti
-
-from ..config import Case, case_from_dict
-from ..io.atomic import atomic_write_text, write_rows
-from ..solver.step import advance
-from .speed import build, field_bytes, peak_rss_mb
+from taichi_sls.config import Case, case_from_dict
+from taichi_sls.io.atomic import atomic_write_text, write_rows
+from taichi_sls.solver.step import advance
 
 DIAMETER_UM = 40.0
 SPACING_UM = 2.0

@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import case_from_dict
-from ..io.atomic import atomic_write_text, write_rows
-from ..solver import linear_solve
-from ..solver.implicit import allocated_row_nodes
-from ..solver.simulation import Simulation
+from taichi_sls.config import case_from_dict
+from taichi_sls.io.atomic import atomic_write_text, write_rows
+from taichi_sls.solver import linear_solve
+from taichi_sls.solver.implicit import allocated_row_nodes
+from taichi_sls.solver.simulation import Simulation
 
 SPACINGS_UM = (4.0, 3.0, 2.5)
 COLUMNS = [

@@ -21,8 +21,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..backend import BACKENDS, DEFAULT, ENV
-from ..config import bundled_cases
+from taichi_sls.backend import BACKENDS, DEFAULT, ENV
+from taichi_sls.config import bundled_cases
 
 # a brief run: a few steps of the case's own step (dt "auto" resolves as in the full run)
 BRIEF = ["time.stop=end", "time.end_s=1e-8", "output.png=false", "output.gif=false"]

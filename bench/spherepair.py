@@ -1,6 +1,6 @@
 """Two touching spheres of a Maxwell liquid coalescing under surface tension, no heat
 (``domain.dim = 3``): ``taichi-sls bench spherepair [--r-over-h 8] [--tau 3.8] [--octant]
-[--out renders]``, then ``--plot`` on the tables (studies/sphere_pair_report.py).
+[--out renders]``, then ``--plot`` on the tables (bench/sphere_pair_report.py).
 
 The 3D counterpart of Hopper's pair (cases/verification/hopper.toml): the same zero-yield
 Perzyna liquid (eta_N = eta / 2 = 0.3 Pa s, Maxwell time 1 us) and surface-energy force, as
@@ -9,7 +9,7 @@ area-equivalent radius of the narrowest c = 1/2 section across the centres), the
 half the span of c >= 1/2 along the line of centres; both are reported over R against
 tau = gamma t / (eta_N R), with the volume change (sum of V0 J over the points); one coalesced
 sphere has x = L = 2^(1/3) R. ``--octant`` runs the eighth of the pair under three mirror
-walls (8x fewer points, the same answer: tests/studies/test_sphere_pair.py) and reads the
+walls (8x fewer points, the same answer: tests/bench/test_sphere_pair.py) and reads the
 measures on its points unfolded into the whole pair. No closed form is checked: 3D sphere
 coalescence has none (Hopper's is 2D); the report sets the run beside Frenkel's and Pokluda et
 al.'s models. Writes sphere_pair_r<R/h>[_octant].csv.
@@ -26,13 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import Case, case_from_dict
-from ..config.loading import add_set_argument, apply_override, bundled_case
-from ..io.atomic import write_rows
-from ..solver.contacts import point_colour
-from ..solver.neck_section import neck_section, pair_reach, trilinear
-from ..solver.simulation import Simulation
-from .sphere_pair_report import report_main
+from bench.sphere_pair_report import report_main
+from taichi_sls.config import Case, case_from_dict
+from taichi_sls.config.loading import add_set_argument, apply_override, bundled_case
+from taichi_sls.io.atomic import write_rows
+from taichi_sls.solver.contacts import point_colour
+from taichi_sls.solver.neck_section import neck_section, pair_reach, trilinear
+from taichi_sls.solver.simulation import Simulation
 
 R_UM = 20.0
 

@@ -1,8 +1,8 @@
-"""A small version of the robustness matrix (``taichi-sls robustness`` runs the whole one)."""
+"""A small version of the robustness matrix (``taichi-sls bench robustness`` runs the whole one)."""
 
 import pytest
 
-from taichi_sls.studies.robustness import matrix, run_row
+from bench.robustness import matrix, run_row
 
 QUICK = [r for r in matrix() if r.quick]
 
@@ -21,4 +21,4 @@ def test_robustness_row_is_stable_or_caught(row):
 def test_full_robustness_matrix_has_no_uncaught_failures(tmp_path):
     from taichi_sls.cli import main
 
-    assert main(["robustness", "--out", str(tmp_path)]) == 0
+    assert main(["bench", "robustness", "--out", str(tmp_path)]) == 0
