@@ -3,7 +3,7 @@
 
 Deposits ``--spheres`` equal spheres over a periodic (x, z) square of ``--side`` diameters,
 once per seed, and reads each bed's bulk fraction (the core window 2 diameters clear of the
-plate and of the mean top; config/packing3d.py) beside Visscher & Bolsterli's 0.58 for random
+plate and of the mean top; config/packing.py) beside Visscher & Bolsterli's 0.58 for random
 sequential deposition with rolling; then the same with side walls (the domain of a case) and
 with a log-normal spread of 0.2. Writes bed3d_packing.csv (one row per bed) and
 bed3d_packing.png: a slice of the first bed through its middle, and the fraction in slabs a
@@ -19,9 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from taichi_sls.config.deposition import lognormal_diameters
-from taichi_sls.config.deposition3d import deposit_spheres
-from taichi_sls.config.packing3d import packing_fractions_3d, slab_volume
+from taichi_sls.config.deposition import deposit, lognormal_diameters
+from taichi_sls.config.packing import packing_fractions, slab_volume
 from taichi_sls.io.atomic import atomic_path
 
 VISSCHER_BOLSTERLI = 0.58  # Nature 239, 504 (1972): sequential deposition with rolling, 3D
@@ -34,7 +33,7 @@ def deposit_bed(n: int, side: float, seed: int, lateral: str, spread: float):
     rng = np.random.default_rng(seed)
     r = lognormal_diameters(rng, n, 1.0, spread) / 2
     t0 = time.perf_counter()
-    c = deposit_spheres(r, (0.0, side), (0.0, side), rng, lateral)  # type: ignore[arg-type]
+    c = deposit(r, [(0.0, side), (0.0, side)], rng, lateral=lateral)  # type: ignore[arg-type]
     return c, r, time.perf_counter() - t0
 
 
@@ -55,7 +54,7 @@ def main(args: argparse.Namespace) -> int:
         for seed in range(args.seeds):
             c, r, wall = deposit_bed(args.spheres, args.side, seed, lateral, spread)
             rng = (0.0, args.side)
-            pf = packing_fractions_3d(c, r, rng, rng, lateral == "periodic")
+            pf = packing_fractions(c, r, [rng, rng], lateral == "periodic")
             rows.append(
                 {
                     "lateral": lateral,

@@ -4,7 +4,7 @@
 
 The 3D counterpart of Hopper's pair (cases/verification/hopper.toml): the same zero-yield
 Perzyna liquid (eta_N = eta / 2 = 0.3 Pa s, Maxwell time 1 us) and surface-energy force, as
-spheres of radius R = 20 um. The neck x is half the 3D neck of solver/section3d.py (the
+spheres of radius R = 20 um. The neck x is half the 3D neck of solver/neck_section.py (the
 area-equivalent radius of the narrowest c = 1/2 section across the centres), the half-length L
 half the span of c >= 1/2 along the line of centres; both are reported over R against
 tau = gamma t / (eta_N R), with the volume change (sum of V0 J over the points); one coalesced
@@ -31,7 +31,7 @@ from taichi_sls.config import Case, case_from_dict
 from taichi_sls.config.loading import add_set_argument, apply_override, bundled_case
 from taichi_sls.io.atomic import write_rows
 from taichi_sls.solver.contacts import point_colour
-from taichi_sls.solver.section3d import neck_diameter, pair_reach_3d, trilinear
+from taichi_sls.solver.neck_section import neck_section, pair_reach, trilinear
 from taichi_sls.solver.simulation import Simulation
 
 R_UM = 20.0
@@ -121,7 +121,7 @@ def full_pair_points(sim: Simulation, octant: bool) -> tuple[np.ndarray, np.ndar
 
 
 def pair_measures(sim: Simulation, octant: bool) -> tuple[float, float]:
-    """(neck x, half-length L) of the pair (m): x half the 3D neck of solver/section3d.py on the
+    """(neck x, half-length L) of the pair (m): x half the 3D neck of solver/neck_section.py on the
     whole pair's colour (filtered as ``contact.neck_colour`` says), L half the span of c >= 1/2
     along the line of centres; both tend to 2^(1/3) R as the pair coalesces into one sphere."""
     cfg = sim.state.cfg
@@ -132,8 +132,8 @@ def pair_measures(sim: Simulation, octant: bool) -> tuple[float, float]:
     field = sim.section_colour(raw) - 0.5
     ca = np.average(x[:first], axis=0, weights=weight[:first])
     cb = np.average(x[first:], axis=0, weights=weight[first:])
-    reach = pair_reach_3d(R_UM * 1e-6, R_UM * 1e-6)
-    neck, _ = neck_diameter(field, cfg.h, cfg.off, ca, cb, reach)
+    reach = pair_reach(R_UM * 1e-6, R_UM * 1e-6, 3)
+    neck, _ = neck_section(field, cfg.h, cfg.off, ca, cb, reach)
     e = (cb - ca) / np.linalg.norm(cb - ca)
     s = np.arange(0.0, 2.0 * reach, cfg.h / 32.0)  # past 2 R, the touching pair's end
     mid = 0.5 * (ca + cb)

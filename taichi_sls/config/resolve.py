@@ -2,7 +2,7 @@
 
 Validating a case (schema.py) only checks it. What a run needs beyond the file's keys is built
 here, by :func:`resolve`, which the loaders call (loading.py ``case_from_dict``, ``load_case``):
-the ``[bed]``'s discs (2D, bed.py) or spheres (3D, bed3d.py) deposited and listed as bodies
+the ``[bed]``'s discs (2D) or spheres (3D) deposited (bed.py) and listed as bodies
 after the case's own and the previous layer's (the table then goes), a domain side the case
 leaves unset fitted to the bed, and each 3D laser's ``z_start_um`` set (default the mid-depth,
 of the fitted domain). The result, a :class:`ResolvedCase`, is itself a valid case: its dump
@@ -11,15 +11,13 @@ of the fitted domain). The result, a :class:`ResolvedCase`, is itself a valid ca
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from pydantic import Field, ValidationError
 
-from .bed import Bed, bed_discs
-from .bed3d import bed_spheres
-from .bodies import Disc, LayerBody
+from .bed import Bed, expand_bed
+from .bodies import LayerBody
 from .errors import CaseError, case_error
 from .layer_file import read_layer
 from .schema import Case
@@ -68,57 +66,9 @@ def resolve(case: Case) -> ResolvedCase:
 
 def _deposit_bed(case: Case) -> dict:
     """Replace ``case.bed`` by its discs or spheres, appended to ``case.bodies`` after the
-    previous layer's bodies; an unset domain width, height (or 3D depth) is fitted to the bed:
-    its x (and z) range, and its top plus one mean diameter, in whole cells. Returns the bed
-    generator's report."""
-    bed: Bed = case.bed
-    dim = case.domain.dim
-    below = _previous_layer(case, bed)
-    layer = read_layer(bed.previous_layer) if below else None
-    given = case.domain.model_fields_set
-    width = case.domain.width_um if "width_um" in given else None
-    height = case.domain.height_um if "height_um" in given else None
-    old = [[*b.center_um, b.radius_um] for b in case.bodies if b.shape == "disc"]
-    old = np.array(old, dtype=float).reshape(-1, dim + 1)
-    sides = {"width_um": width, "height_um": height}
-    if dim == 2:
-        if layer is not None:  # the new discs land on the layer's points, each a disc in its square
-            old = np.concatenate([old, layer.balls_um()])
-        join = 2.0 * case.contact.fillet_radius_um if case.contact.initial == "fillet" else 0.0
-        discs = bed_discs(bed, old, width, height, join)
-        centres, radii, report = np.stack([discs.x, discs.y], axis=1), discs.r, discs.report
-    else:
-        # without depth_um the domain is as deep as it is wide (Domain.depth)
-        sides["depth_um"] = case.domain.depth_um if case.domain.depth_um is not None else width
-        floor = layer.balls_um() if layer is not None else None
-        centres, radii, report = bed_spheres(bed, old, *sides.values(), floor=floor)
-    if layer is not None:
-        report.update(layer.bed_report(bed.previous_layer))
-    h = case.grid.spacing_um
-    fit = {
-        "width_um": max(report["x_range_um"][1], float(np.max(centres[:, 0] + radii))),
-        "height_um": float(np.max(centres[:, 1] + radii)) + 2.0 * float(np.mean(radii)),
-    }
-    if dim == 3:
-        fit["depth_um"] = max(report["z_range_um"][1], float(np.max(centres[:, 2] + radii)))
-    for key, reach in fit.items():
-        if sides[key] is None:
-            setattr(case.domain, key, h * math.ceil(reach / h - 1e-9))
-    case.bodies = [
-        *case.bodies,
-        *below,
-        *(
-            Disc(
-                center_um=[float(v) for v in c],
-                radius_um=float(r),
-                material=bed.material,
-                temperature_C=bed.temperature_C,
-            )
-            for c, r in zip(centres, radii, strict=True)
-        ),
-    ]
-    case.bed = None
-    return report
+    previous layer's bodies, and fit an unset domain side to the bed (config/bed.py
+    ``expand_bed``). Returns the bed generator's report."""
+    return expand_bed(case, _previous_layer(case, case.bed))
 
 
 def _previous_layer(case: Case, bed: Bed) -> list[LayerBody]:

@@ -27,7 +27,7 @@ Per contact (a, b) of ``Simulation.contacts``:
 In 3D (``domain.dim = 3``) the same record: the contact point on the line of the sphere centres
 where the radical plane crosses it, the neck region the points within the slab of half-width
 ``fusion.neck_region_cells`` cells about that plane and within the smaller radius of the line of
-centres, the necks read by the 3D section (solver/section3d.py: the diameter 2 sqrt(A / pi) of
+centres, the necks read by the 3D section (solver/neck_section.py: the diameter 2 sqrt(A / pi) of
 the narrowest c = 1/2 section normal to the line of centres), the relative density under the
 layer's top surface over the bed area and the track's width across the scan
 (jobs/bed_layer.py). The contacts and outcome plots draw the points and contacts projected onto
@@ -44,7 +44,7 @@ import numpy as np
 
 from ..config import Case
 from ..solver.simulation import Simulation
-from .bed_layer import melt_extent, relative_density, relative_density_3d
+from .bed_layer import layer_density, melt_extent
 from .outcome import laser_acted
 
 NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
@@ -158,38 +158,6 @@ class ContactHistory:
                 }
             )
         return out
-
-
-def layer_density(sim: Simulation) -> dict[str, float]:
-    """The layer's relative density now (jobs/bed_layer.py) between the bed's side walls."""
-    cfg = sim.state.cfg
-    rep = sim.case.bed_report
-    if cfg.dim == 3:
-        return _layer_density_3d(sim, rep)
-    if rep is not None:
-        lo, hi = (v * 1e-6 for v in rep["x_range_um"])
-    else:  # bodies listed one by one: the x-extent of the points as seeded
-        x0 = sim.scene.x[:, 0]
-        half = 0.5 * cfg.h / sim.case.grid.points_per_cell
-        lo, hi = float(x0.min()) - half, float(x0.max()) + half
-    return relative_density(
-        sim.raw_colour(), cfg.h, cfg.off, (lo, hi), sim.case.domain.height_um * 1e-6
-    )
-
-
-def _layer_density_3d(sim: Simulation, rep: dict | None) -> dict[str, float]:
-    """layer_density in 3D: over the bed's x and z ranges (the points' extents as seeded
-    without a generated bed)."""
-    cfg = sim.state.cfg
-    if rep is not None:
-        ranges = [tuple(v * 1e-6 for v in rep[k]) for k in ("x_range_um", "z_range_um")]
-    else:
-        x0 = sim.scene.x
-        half = 0.5 * cfg.h / sim.case.grid.points_per_cell
-        ranges = [(float(x0[:, k].min()) - half, float(x0[:, k].max()) + half) for k in (0, 2)]
-    return relative_density_3d(
-        sim.raw_colour(), cfg.h, cfg.off, ranges[0], ranges[1], sim.case.domain.height_um * 1e-6
-    )
 
 
 def track_across_axis(case: Case) -> int:

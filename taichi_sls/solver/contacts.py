@@ -1,5 +1,6 @@
 """Contacts between bodies: which bodies touch, the initial neck that joins two touching discs,
-and the neck of every contact read across the line of its bodies' centres.
+and the colour of one pair's points alone. The neck of a contact is read across the line of its
+bodies' centres by solver/neck_section.py.
 
 In a bed a section across one contact also crosses the neighbouring particles, and the outermost
 crossings then span them: ``point_colour`` gives the colour of one pair's points alone, on which
@@ -30,9 +31,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 TOUCH_SPACINGS = 1.5  # two bodies touch where their points lie this many point spacings apart
-SECTION_STEP = 0.125  # sampling of a neck section, in cells (sub-cell: the crossings are linear)
-FAR_APART = 16.0  # centres farther apart than this many body radii: no neck to read
-SECTION_RANGE = 0.25  # sections across the middle half of the centre distance (each side)
 
 
 @dataclass(frozen=True)
@@ -96,94 +94,6 @@ def touching(points: np.ndarray, body: np.ndarray, spacing: float) -> list[tuple
     return sorted({(int(a), int(b)) for a, b in zip(lo, hi, strict=True)})
 
 
-def neck_width(
-    material: np.ndarray,
-    h: float,
-    off: int,
-    ca: np.ndarray,
-    cb: np.ndarray,
-    reach: float,
-) -> tuple[float, np.ndarray]:
-    """The neck of one contact (m), and where it lies, on a node field that is >= 0 in the
-    material (c - 1/2 of the colour, or -phi of eq. 21).
-
-    Sections perpendicular to the line of centres ca -> cb, across its middle half: along each,
-    the field (bilinear between nodes, as the outline's marching squares are linear along cell
-    edges) is sampled every SECTION_STEP cells out to ``reach`` on either side, and the width is
-    the distance between the outermost crossings of the interface (so that the empty strip of
-    points along a symmetry line, a hole inside the neck, does not shorten it). The neck is the
-    narrowest section, or the widest once the pair has turned convex (no waist: the narrowest
-    would be the range's end); 0 where a section holds no material (a torn neck).
-    """
-    d = float(np.linalg.norm(cb - ca))
-    # a blown-up state (the guard reports it): centres NaN, or flung far beyond the bodies' size
-    if not (math.isfinite(d) and math.isfinite(reach) and 0.0 < d <= FAR_APART * reach):
-        return math.nan, np.full(2, math.nan)
-    e = (cb - ca) / d
-    n = np.array([-e[1], e[0]])
-    step = SECTION_STEP * h
-    s = np.arange((0.5 - SECTION_RANGE) * d, (0.5 + SECTION_RANGE) * d + 0.5 * step, step)
-    # whole steps either side of the line of centres: the same samples whatever the reach, so a
-    # longer reach reads a section inside the shorter one's span as that one did
-    n_t = math.ceil(reach / step - 1e-9)
-    t = step * np.arange(-n_t, n_t + 1)
-    xy = ca[None, None, :] + s[:, None, None] * e + t[None, :, None] * n  # (S, T, 2)
-    c = bilinear(material, h, off, xy[..., 0], xy[..., 1], outside=-1.0)
-    widths = np.array([_outer_span(row, t) for row in c])
-    k = int(np.argmin(widths))
-    # a pair coalesced past its waist is convex: its sections narrow away from the middle, and
-    # the narrowest is the range's end, not the neck; read it where it is widest (Hopper's r_n
-    # is the middle section). A pair with a waist (every cold or part-fused contact) keeps
-    # the narrowest section.
-    mid = len(s) // 2
-    if k in (0, len(s) - 1) and widths[mid] > max(widths[0], widths[-1]):
-        k = int(np.argmax(widths))
-    return float(widths[k]), ca + s[k] * e
-
-
-def pair_reach(ra: float, rb: float) -> float:
-    """How far either side of the line of centres a section of one pair is sampled (m).
-
-    sqrt(ra^2 + rb^2), the radius of the disc holding both bodies' area: the end state of a
-    coalescence, so the section of a pair fused to the end still lies within it (the smaller
-    radius, the earlier reach, capped the width at the initial diameter).
-    """
-    return math.sqrt(ra * ra + rb * rb)
-
-
-def _outer_span(c: np.ndarray, t: np.ndarray) -> float:
-    """Distance between the outermost crossings of c = 0 (c > 0: material) along t."""
-    inside = np.nonzero(c >= 0.0)[0]
-    if len(inside) == 0:
-        return 0.0
-    lo, hi = inside[0], inside[-1]
-    t0 = t[lo] if lo == 0 else t[lo - 1] + (t[lo] - t[lo - 1]) * c[lo - 1] / (c[lo - 1] - c[lo])
-    t1 = t[hi]
-    if hi < len(t) - 1:
-        t1 = t[hi] + (t[hi + 1] - t[hi]) * c[hi] / (c[hi] - c[hi + 1])
-    return float(t1 - t0)
-
-
-def bilinear(
-    field: np.ndarray, h: float, off: int, x: np.ndarray, y: np.ndarray, outside: float = 0.0
-) -> np.ndarray:
-    """A node field (array index i at x = (i - off) h) interpolated bilinearly at (x, y) (m);
-    ``outside`` beyond the arrays."""
-    u, v = x / h + off, y / h + off
-    i, j = np.floor(u).astype(int), np.floor(v).astype(int)
-    fu, fv = u - i, v - j
-    nx, ny = field.shape
-    ok = (i >= 0) & (j >= 0) & (i < nx - 1) & (j < ny - 1)
-    i, j = np.where(ok, i, 0), np.where(ok, j, 0)
-    out = (
-        field[i, j] * (1 - fu) * (1 - fv)
-        + field[i + 1, j] * fu * (1 - fv)
-        + field[i, j + 1] * (1 - fu) * fv
-        + field[i + 1, j + 1] * fu * fv
-    )
-    return np.where(ok, out, outside)
-
-
 def _gimp_1d(xi: np.ndarray, h: float, lp: float) -> np.ndarray:
     """The uGIMP weight of physics/shape.py (gimp_1d), in numpy."""
     a = np.abs(xi)
@@ -215,14 +125,4 @@ def point_colour(
                 continue
             for c in range(3):  # 3D: the third axis of the stencil
                 np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b, idx[:, 2] + c), wab * w[c][:, 2])
-    return out
-
-
-def filtered_colour(c: np.ndarray) -> np.ndarray:
-    """The force's colour filter (physics/surface_energy.py, colour_field) in numpy: one
-    [1 2 1] / 4 pass along x and y on the interior nodes, 0 on the arrays' edge. It closes the
-    one-cell notch that the points of two bodies leave along a node-line mid-plane."""
-    out = np.zeros_like(c)
-    inner = c[:-2, :] + 2.0 * c[1:-1, :] + c[2:, :]
-    out[1:-1, 1:-1] = 0.0625 * (inner[:, :-2] + 2.0 * inner[:, 1:-1] + inner[:, 2:])
     return out

@@ -4,10 +4,10 @@ set and colour on the nodes, the contact line of the paper's pair, the neck of e
 import numpy as np
 
 from . import struct_copy
-from .contacts import filtered_colour, neck_width, pair_reach, point_colour
+from .contacts import point_colour
 from .grid_views import interface_fields
 from .monitor import neck_measures
-from .section3d import filtered_colour_3d, neck_diameter, pair_reach_3d
+from .neck_section import filtered_colour, neck_section, pair_reach
 
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
 # own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
@@ -60,7 +60,7 @@ class NeckMeasures:
         measure = measure or self.neck_measure()
         if measure == "level_set" and self.state.cfg.dim == 3:
             return float("nan"), float("nan")  # eq. 21's level set is 2D
-        # 3D: the section across the centres (solver/section3d.py), a column has no meaning
+        # 3D: the section across the centres (solver/neck_section.py), a column has no meaning
         if self.case.contact.neck_section == "centres" or self.state.cfg.dim == 3:
             if not self.contacts:
                 return 0.0, 0.0
@@ -95,26 +95,32 @@ class NeckMeasures:
         mid-plane) or itself (``"raw"``: the seeded outline, a concave neck unwidened)."""
         if self.case.contact.neck_colour != "filtered":
             return raw
-        return filtered_colour(raw) if raw.ndim == 2 else filtered_colour_3d(raw)
+        return filtered_colour(raw)
 
     def necks_m(self, measure: str | None = None) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``: the narrowest section
         across the line of the two bodies' mass centres, between the outermost crossings of the
-        interface (:func:`taichi_sls.solver.contacts.neck_width`), out to the pair's reach."""
+        interface (:func:`taichi_sls.solver.neck_section.neck_section`), out to the pair's reach."""
         if not self.contacts:
             return []
         field = self._material_field(measure or self.neck_measure(), "centres")
         return self._contact_necks(lambda a, b: field)
 
     def _contact_necks(self, field_of) -> list[float]:
-        """neck_width of every contact on ``field_of(a, b)``, sampled out to
-        :func:`~taichi_sls.solver.contacts.pair_reach`: the coalesced end state of the pair,
-        so a neck is followed past the bodies' initial diameter (issue #40 item 6). 3D: the
-        diameter 2 sqrt(A / pi) of the section (solver/section3d.py, ``neck_diameter``)."""
+        """neck_section of every contact on ``field_of(a, b)``, sampled out to
+        :func:`~taichi_sls.solver.neck_section.pair_reach`: the coalesced end state of the
+        pair, so a neck is followed past the bodies' initial diameter (issue #40 item 6). 3D:
+        the diameter 2 sqrt(A / pi) of the section."""
         centre, r, cfg = self.body_centres_m(), self._body_radius, self.state.cfg
-        neck, reach = (neck_width, pair_reach) if cfg.dim == 2 else (neck_diameter, pair_reach_3d)
         return [
-            neck(field_of(a, b), cfg.h, cfg.off, centre[a], centre[b], reach(r[a], r[b]))[0]
+            neck_section(
+                field_of(a, b),
+                cfg.h,
+                cfg.off,
+                centre[a],
+                centre[b],
+                pair_reach(r[a], r[b], cfg.dim),
+            )[0]
             for a, b in self.contacts
         ]
 

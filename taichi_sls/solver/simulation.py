@@ -23,10 +23,10 @@ from .guard import Guard, temperature_floor_K
 from .handover import Handover, explicit_view
 from .implicit import ImplicitStepper
 from .monitor import point_monitors
+from .neck_section import equivalent_radii
 from .necks import NeckMeasures
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
-from .section3d import equivalent_radii
 from .step import advance, init_box
 from .step_config import Layout, choose_layout, step_config
 from .time_step import (

@@ -181,20 +181,26 @@ def test_pair_colour_is_the_steps_p2g(tmp_path):
     assert len(sim.pair_necks_m()) == len(TANGENT)
 
 
-def test_relative_density_of_a_block_with_a_hole():
+@pytest.mark.parametrize("dim", [2, 3])
+def test_relative_density_of_a_block_with_a_hole(dim):
     """A full block of material from the plate up to a flat top (c = 1 on its nodes, 0 above:
     the c = 1/2 crossing half a cell above the last full node row) reads 1; a hole of 4 x 4
-    cells in it removes its area."""
+    cells (4 x 4 x 4 in 3D) in it removes its area (volume)."""
     h, off = 1.0, 2
-    c = np.zeros((44, 30))
-    c[off : off + 41, : off + 11] = 1.0  # x 0..40, y up to 10 (+ h/2 to the crossing)
-    full = relative_density(c, h, off, (0.0, 40.0), 28.0)
+    depth = (0.0, 8.0)  # 3D: z over 0..8
+    c = np.zeros((44, 30, 24)[:dim])
+    across = (slice(off, off + 9),) if dim == 3 else ()
+    c[(slice(off, off + 41), slice(None, off + 11), *across)] = 1.0  # x 0..40, y to 10
+    ranges = [(0.0, 40.0), depth][: dim - 1]
+    full = relative_density(c, h, off, ranges, 28.0)
     assert full["relative_density"] == pytest.approx(1.0)
     assert full["mean_top_m"] == pytest.approx(10.5, abs=0.13)
-    # nodes x 10..13, y 3..6 empty: c < 1/2 from half a cell before them to half after, 4 x 4
-    c[off + 10 : off + 14, off + 3 : off + 7] = 0.0
-    holed = relative_density(c, h, off, (0.0, 40.0), 28.0)
-    assert holed["relative_density"] == pytest.approx(1.0 - 16.0 / (40.0 * 10.5), abs=0.005)
+    # nodes x 10..13, y 3..6 (z 2..5) empty: c < 1/2 from half a cell before them to half after
+    hole = (slice(off + 10, off + 14), slice(off + 3, off + 7), slice(off + 2, off + 6))
+    c[hole[:dim]] = 0.0
+    holed = relative_density(c, h, off, ranges, 28.0)
+    envelope = 40.0 * 10.5 * (depth[1] if dim == 3 else 1.0)
+    assert holed["relative_density"] == pytest.approx(1.0 - 4.0**dim / envelope, abs=0.005)
 
 
 def test_melt_extent_counts_each_point_with_its_square():

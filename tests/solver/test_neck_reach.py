@@ -1,4 +1,4 @@
-"""The per-contact neck (neck_width with pair_reach) read on the exact Hopper outline, no
+"""The per-contact neck (neck_section with pair_reach) read on the exact Hopper outline, no
 simulation: it follows the coalescence past the initial diameter (issue #40 item 6)."""
 
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from taichi_sls import load_case
-from taichi_sls.solver.contacts import neck_width, pair_reach
+from taichi_sls.solver.neck_section import neck_section, pair_reach
 from taichi_sls.solver.simulation import Simulation
 from taichi_sls.studies.references.hopper import (
     hopper_neck_at,
@@ -29,7 +29,7 @@ def _hopper_field(z: np.ndarray, nu: float, R0: float) -> np.ndarray:
 
 
 def _read(tau: float, turn_deg: float) -> float:
-    """r_n / R0 read by neck_width (reach pair_reach) on the signed distance to the exact
+    """r_n / R0 read by neck_section (reach pair_reach) on the signed distance to the exact
     outline (> 0 inside, the kind of field phi of eq. 21 is) sampled on the nodes at
     R0/h = 20, the outline turned by ``turn_deg`` about the neck.
 
@@ -52,7 +52,7 @@ def _read(tau: float, turn_deg: float) -> float:
     zf = (FX + 1j * FY)[_hopper_field(FX + 1j * FY, nu, R0) >= 0.0]
     za, zb = zf[zf.real < 0].mean() * turn, zf[zf.real > 0].mean() * turn
     ca, cb = np.array([za.real, za.imag]), np.array([zb.real, zb.imag])
-    w, _ = neck_width(field, h, off, ca, cb, pair_reach(R0, R0))
+    w, _ = neck_section(field, h, off, ca, cb, pair_reach(R0, R0))
     return 0.5 * w / R0
 
 
@@ -89,7 +89,7 @@ def test_a_neck_below_the_initial_diameter_reads_as_before(name, sets):
     sim = Simulation(load_case(name, ["solver.optimize=false", *sets]))
     field = sim._material_field(sim.neck_measure(), "centres")
     centre, (ra, rb), cfg = sim.body_centres_m(), sim.body_radii_m[:2], sim.state.cfg
-    old, _ = neck_width(field, cfg.h, cfg.off, centre[0], centre[1], min(ra, rb))
+    old, _ = neck_section(field, cfg.h, cfg.off, centre[0], centre[1], min(ra, rb))
     assert 0.0 < old < 2.0 * min(ra, rb)
     assert sim.necks_m()[0] == pytest.approx(old, rel=1e-12)
     assert sim.monitors()["contact_line_um"] == pytest.approx(old * 1e6, rel=1e-12)

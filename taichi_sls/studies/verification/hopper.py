@@ -47,9 +47,9 @@ def hopper_frame(case: Case) -> tuple[float, np.ndarray, float]:
 def turned_section(c: np.ndarray, h: float, off: int, centre: np.ndarray, turn: float) -> float:
     """Length (m) inside the colour's c = 1/2 outline along the mid-plane through ``centre``
     perpendicular to the line of centres at angle ``turn``: c bilinear between the nodes (as
-    the neck sections of solver/contacts.py read it), sampled every h / 32."""
-    from ...solver.contacts import bilinear
+    the neck sections of solver/neck_section.py read it), sampled every h / 32."""
     from ...solver.monitor import column_material_length
+    from ...solver.neck_section import bilinear
 
     step = h / 32.0
     reach = h * (max(c.shape) + 1)

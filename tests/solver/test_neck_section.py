@@ -1,5 +1,6 @@
-"""The neck of a contact in 3D (solver/section3d.py): the c = 1/2 section normal to the line
-of centres, read as 2 sqrt(A / pi), the narrowest over the middle half of the centre distance;
+"""The neck of a contact (solver/neck_section.py): in 2D the width of a section line across the
+line of centres, in 3D the c = 1/2 section normal to it, read as 2 sqrt(A / pi), the narrowest
+over the middle half of the centre distance; what both share, tested over dim;
 the fillet contact of two spheres (the torus bridge, scene._sphere_bridges); a sphere's Laplace
 pressure 2 gamma / R. Numpy fields and seeded scenes here (no Taichi kernel); the runs of
 settle and stop = "solidified" in 3D are in tests/jobs/test_settle3d.py."""
@@ -11,13 +12,13 @@ import pytest
 from helpers import make_case
 
 from taichi_sls.solver.contacts import fillet, in_bridge
-from taichi_sls.solver.scene import build_scene, laplace_pressure
-from taichi_sls.solver.section3d import (
+from taichi_sls.solver.neck_section import (
     equivalent_radii,
-    filtered_colour_3d,
-    neck_diameter,
+    filtered_colour,
+    neck_section,
     section_area,
 )
+from taichi_sls.solver.scene import build_scene, laplace_pressure
 
 R = 20e-6
 OFF = 3  # array index of the node at 0
@@ -59,7 +60,7 @@ def test_the_waist_of_a_hyperboloid_reads_its_circle(R_over_h, tol):
     P = _nodes(h, 4 * R)
     s = P[..., 0] - 0.5 * (ca[0] + cb[0])
     field = np.sqrt(a * a + 0.5 * s * s) - np.hypot(P[..., 1] - ca[1], P[..., 2] - ca[2])
-    width, at = neck_diameter(field, h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
+    width, at = neck_section(field, h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
     assert width == pytest.approx(2 * a, rel=tol)
     assert abs(at[0] - 0.5 * (ca[0] + cb[0])) <= h  # the narrowest plane is the waist's
 
@@ -80,7 +81,7 @@ def test_a_fillet_torus_reads_its_neck(R_over_h, tol):
     tube = np.hypot(s - R, r - f.centre_plus[1]) - rho
     half = R - R * R / (R + rho)  # the tangent points' distance from the mid-plane
     bridge = np.where((np.abs(s - R) <= half) & (r < f.centre_plus[1]), tube, -1.0)
-    width, _ = neck_diameter(np.maximum(spheres, bridge), h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
+    width, _ = neck_section(np.maximum(spheres, bridge), h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
     assert width == pytest.approx(f.neck_width, rel=tol)
 
 
@@ -93,26 +94,72 @@ def test_a_coalesced_sphere_reads_its_diameter():
     P = _nodes(h, 4 * R)
     big = 2 ** (1 / 3) * R
     field = big - np.linalg.norm(P - 0.5 * (ca + cb), axis=-1)
-    width, _ = neck_diameter(field, h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
+    width, _ = neck_section(field, h, OFF, ca, cb, (2 * R**3) ** (1 / 3))
     assert width == pytest.approx(2 * big, rel=0.01)
 
 
-def test_no_material_and_a_blown_up_state():
+@pytest.mark.parametrize("dim", [2, 3])
+def test_no_material_reads_zero_and_a_blown_up_state_nan(dim):
+    """No material on the sections: a neck of 0 (torn). NaN centres (the state the guard
+    reports) or centres flung far apart: a NaN neck and place, not an exception, so that the
+    failed run's last frame is still written."""
     h = R / 5
     ca, cb = _pair(h, 2 * R)
-    empty = -np.ones(_nodes(h, 4 * R).shape[:3])
-    assert neck_diameter(empty, h, OFF, ca, cb, R)[0] == 0.0
-    assert math.isnan(neck_diameter(empty, h, OFF, ca, ca + np.nan, R)[0])
+    ca, cb = ca[:dim], cb[:dim]
+    empty = -np.ones(_nodes(h, 4 * R).shape[:dim])
+    assert neck_section(empty, h, OFF, ca, cb, R)[0] == 0.0
+    width, where = neck_section(empty, h, OFF, ca, ca + np.nan, R)
+    assert math.isnan(width) and np.isnan(where).all() and len(where) == dim
+    far = cb.copy()
+    far[0] = 1e30
+    assert math.isnan(neck_section(empty, h, OFF, ca, far, R)[0])
 
 
-def test_the_3d_filter_is_the_force_filter():
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_filter_is_the_force_filter(dim):
     """[1 2 1] / 4 along each axis on the interior nodes: a node's unit spike spreads to
-    1/8 at itself and weights that sum to 1, 0 on the arrays' edge."""
-    c = np.zeros((7, 7, 7))
-    c[3, 3, 3] = 1.0
-    f = filtered_colour_3d(c)
-    assert f[3, 3, 3] == pytest.approx(0.125) and f[2, 3, 3] == pytest.approx(0.0625)
+    1/2^dim at itself and weights that sum to 1, 0 on the arrays' edge."""
+    c = np.zeros((7,) * dim)
+    c[(3,) * dim] = 1.0
+    f = filtered_colour(c)
+    assert f[(3,) * dim] == pytest.approx(0.5**dim)
+    assert f[(2,) + (3,) * (dim - 1)] == pytest.approx(0.5 ** (dim + 1))
     assert f.sum() == pytest.approx(1.0) and f[0].sum() == 0.0
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 30.0, 45.0])
+def test_neck_width_reads_a_band_exactly_at_any_angle_and_ignores_a_hole(angle_deg):
+    """A band of material of width w across the line of centres, rotated: the field is linear
+    near its edges, so bilinear interpolation puts the crossings exactly; an empty strip along
+    the line of centres (the stagnation strip) does not shorten the neck."""
+    h, off, w = 1.0, 2, 7.3
+    th = math.radians(angle_deg)
+    e = np.array([math.cos(th), math.sin(th)])
+    n = np.array([-e[1], e[0]])
+    ca = np.array([20.0, 20.0]) - 10.0 * e
+    cb = np.array([20.0, 20.0]) + 10.0 * e
+    i = np.arange(45)
+    X, Y = np.meshgrid((i - off) * h, (i - off) * h, indexing="ij")
+    t = (X - 20.0) * n[0] + (Y - 20.0) * n[1]
+    field = w / 2 - np.abs(t)
+    width, where = neck_section(field, h, off, ca, cb, 9.0)
+    assert width == pytest.approx(w, abs=1e-9)
+    holed = np.where(np.abs(t) < 0.4, -0.2, field)
+    assert neck_section(holed, h, off, ca, cb, 9.0)[0] == pytest.approx(w, abs=1e-9)
+
+
+def test_neck_width_is_the_narrowest_section_and_zero_when_torn():
+    """An hourglass: the width grows away from the mid-plane; the narrowest section is read.
+    With no material on the mid-plane the neck is 0."""
+    h, off = 0.5, 2
+    i = np.arange(100)
+    X, Y = np.meshgrid((i - off) * h, (i - off) * h, indexing="ij")
+    field = (3.0 + 0.2 * np.abs(X - 20.0)) - np.abs(Y - 20.0)
+    width, where = neck_section(field, h, off, np.array([12.0, 20.0]), np.array([28.0, 20.0]), 15.0)
+    assert width == pytest.approx(6.0, abs=1e-9)
+    assert where == pytest.approx([20.0, 20.0], abs=h / 8)
+    torn = np.where(np.abs(X - 20.0) < 1.0, -1.0, field)
+    assert neck_section(torn, h, off, np.array([12.0, 20.0]), np.array([28.0, 20.0]), 15.0)[0] == 0
 
 
 SPHERES = {
