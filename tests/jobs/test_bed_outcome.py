@@ -177,8 +177,8 @@ def test_pair_colour_is_the_steps_p2g(tmp_path):
     x = sim.state.points.x.to_numpy()
     weight = sim.state.points.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
     mine = point_colour(x, weight, cfg.h, cfg.lp, cfg.off, (cfg.nx, cfg.ny))
-    assert np.abs(mine - sim.raw_colour()).max() < 1e-12
-    assert len(sim.pair_necks_m()) == len(TANGENT)
+    assert np.abs(mine - sim.necks.raw_colour()).max() < 1e-12
+    assert len(sim.necks.pair_necks_m()) == len(TANGENT)
 
 
 def test_relative_density_of_a_block_with_a_hole():

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import advance_steps
 
 from taichi_sls.io.atomic import write_rows
 from taichi_sls.solver.simulation import Simulation
@@ -44,7 +45,7 @@ def test_the_octant_runs_the_whole_pair():
     for octant in (True, False):
         case = sphere_pair_case(4.0, 0.02, octant=octant, on_nodes=True)
         sim = Simulation(case)
-        sim.advance(400)
+        advance_steps(sim, 400)
         results.append(
             (pair_measures(sim, octant), sim.point_arrays(("volume0",))["volume0"].sum())
         )
