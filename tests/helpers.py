@@ -17,7 +17,14 @@ PAPER_SCENE = {
     ],
 }
 
-__all__ = ["PAPER_SCENE", "deep_update", "guard_message", "make_case", "neck_and_kinetic_energy"]
+__all__ = [
+    "PAPER_SCENE",
+    "advance_steps",
+    "deep_update",
+    "guard_message",
+    "make_case",
+    "neck_and_kinetic_energy",
+]
 
 
 def make_case(data: dict):

@@ -34,9 +34,8 @@ from . import struct_copy
 from .adaptive import AdaptiveStepper, next_step
 from .fields import State
 from .scene import Scene
-from .step import ExplicitStepper
 from .step_config import step_config
-from .stepper import NO_HOOKS, StepHooks, whole_steps
+from .stepper import NO_HOOKS, ExplicitStepper, StepHooks, whole_steps
 from .time_step import (
     resolve_curvature_every,
     resolve_heat_every,

@@ -26,9 +26,9 @@ from .monitor import point_monitors
 from .necks import HOST_POINT_MEMBERS, Necks, point_arrays
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
-from .step import ExplicitStepper, init_box
+from .step import init_box
 from .step_config import Layout, choose_layout, step_config
-from .stepper import StepHooks, Stepper
+from .stepper import ExplicitStepper, StepHooks, Stepper
 from .time_step import (
     heat_step_max,
     resolve_curvature_every,

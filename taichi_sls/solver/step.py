@@ -69,7 +69,6 @@ from .loops import (
     wall_heat_in_order,
 )
 from .periodic import with_periodic
-from .stepper import NO_HOOKS, StepHooks, fixed_steps_to, whole_steps
 
 
 @ti.func
@@ -416,28 +415,3 @@ def advance_staged(st: State, n: int) -> None:
     for i in range(k, k + n):
         for stage in STAGES:
             run_stage(st, stage, *_clocks(st, i))
-
-
-class ExplicitStepper:
-    """Explicit steps of a fixed dt (:mod:`taichi_sls.solver.stepper`'s protocol) on ``st``:
-    the run's state, or the hybrid's explicit view of it."""
-
-    def __init__(self, st: State, dt: float) -> None:
-        self.st = st
-        self.dt = dt
-
-    @property
-    def last_dt(self) -> float:
-        return self.dt
-
-    def compile(self) -> None:
-        advance(self.st, 0)
-
-    def take(self, n: int) -> None:
-        """n steps, as :func:`advance` takes them."""
-        advance(self.st, n)
-
-    def advance_to(self, t: float, hooks: StepHooks = NO_HOOKS) -> int:
-        """The whole steps nearest to t (s)."""
-        n = fixed_steps_to(float(self.st.scalars.t[None]), t, self.dt)
-        return whole_steps(self.take, n, hooks)

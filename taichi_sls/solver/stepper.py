@@ -5,7 +5,7 @@
     advance_to(t, hooks)    step until the clock reaches t (s); returns the steps taken
     last_dt                 the last step's length (s): the fixed dt, or the adaptive step's
 
-The steppers: :class:`~taichi_sls.solver.step.ExplicitStepper` (the explicit step, fixed dt),
+The steppers: :class:`ExplicitStepper` (the explicit step of solver/step.py, fixed dt),
 :class:`~taichi_sls.solver.implicit.ImplicitStepper` (backward Euler, fixed dt),
 :class:`~taichi_sls.solver.extrapolation.ExtrapolatedStepper` (its Richardson extrapolation),
 :class:`~taichi_sls.solver.adaptive.AdaptiveStepper` (either, at a step the physics chooses) and
@@ -18,6 +18,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
+
+from .fields import State
+from .step import advance
 
 
 @dataclass(frozen=True)
@@ -64,3 +67,28 @@ def whole_steps(take: Callable[[int], None], n: int, hooks: StepHooks) -> int:
         if hooks.after is not None:
             hooks.after()
     return n
+
+
+class ExplicitStepper:
+    """Explicit steps of a fixed dt (the protocol above) on ``st``:
+    the run's state, or the hybrid's explicit view of it."""
+
+    def __init__(self, st: State, dt: float) -> None:
+        self.st = st
+        self.dt = dt
+
+    @property
+    def last_dt(self) -> float:
+        return self.dt
+
+    def compile(self) -> None:
+        advance(self.st, 0)
+
+    def take(self, n: int) -> None:
+        """n steps, as :func:`advance` takes them."""
+        advance(self.st, n)
+
+    def advance_to(self, t: float, hooks: StepHooks = NO_HOOKS) -> int:
+        """The whole steps nearest to t (s)."""
+        n = fixed_steps_to(float(self.st.scalars.t[None]), t, self.dt)
+        return whole_steps(self.take, n, hooks)

@@ -220,8 +220,9 @@ def test_a_pairs_contact_region_is_the_pair_verdicts_neck_region():
         case=case,
         contacts=[(0, 1)],
         scene=sc,
-        body_radii_m=np.sqrt(area / np.pi),
-        body_centres_m=lambda initial: centres,
+        necks=SimpleNamespace(
+            body_radii_m=np.sqrt(area / np.pi), body_centres_m=lambda initial: centres
+        ),
         point_arrays=lambda keys: {"x0": sc.x},
         state=SimpleNamespace(cfg=SimpleNamespace(h=case.grid.spacing_um * 1e-6)),
     )
