@@ -286,7 +286,7 @@ def run_paper(spacings: list[float], out: Path, end_s: float = 1e-3) -> list[dic
             try:
                 n = int(round(end_s / sim.dt))
                 for k in range(10):  # monitors (and the guard) ten times over the run
-                    sim.advance(n * (k + 1) // 10 - n * k // 10)
+                    sim.advance_to(sim.t + (n * (k + 1) // 10 - n * k // 10) * sim.dt)
                     mon = sim.monitors()
             except SimulationError as e:
                 status = f"failed: {e}"

@@ -61,7 +61,7 @@ def run_one(case_name: str, sets: list[str], end_s: float, every_s: float) -> li
     for k in range(last + 1):
         try:
             if k:
-                sim.advance(n)
+                sim.advance_to(sim.t + n * sim.dt)
             m = sim.monitors()
         except SimulationError as e:
             m, status = dict.fromkeys(MONITORS, float("nan")), f"failed: {e}"

@@ -137,7 +137,7 @@ def run_row(row: Row, frames: int = 10) -> dict:
     last = first
     try:
         for _ in range(frames):
-            sim.advance(n)
+            sim.advance_to(sim.t + n * sim.dt)
             last = sim.monitors()
     except SimulationError as e:
         result, note = "caught", str(e)

@@ -103,7 +103,7 @@ def full_pair_points(sim: Simulation, octant: bool) -> tuple[np.ndarray, np.ndar
     """The pair's point positions (m) and colour weights (the mass colour m / (rho V_cell), or
     the volume colour where the force uses it), and which of them are the first sphere's count;
     an octant's points unfolded over its three mirror planes into the whole pair."""
-    x, weight = sim.point_arrays(("x",))["x"], sim.colour_weights()
+    x, weight = sim.point_arrays(("x",))["x"], sim.necks.colour_weights()
     if not octant:
         order = np.argsort(sim.scene.body, kind="stable")
         return x[order], weight[order], int(np.sum(sim.scene.body == 0))
@@ -129,7 +129,7 @@ def pair_measures(sim: Simulation, octant: bool) -> tuple[float, float]:
     extent = x.max(axis=0) + 4 * cfg.h
     shape = tuple(int(math.ceil(e / cfg.h)) + 2 * cfg.off + 4 for e in extent)
     raw = point_colour(x, weight, cfg.h, cfg.lp, cfg.off, shape)
-    field = sim.section_colour(raw) - 0.5
+    field = sim.necks.section_colour(raw) - 0.5
     ca = np.average(x[:first], axis=0, weights=weight[:first])
     cb = np.average(x[first:], axis=0, weights=weight[first:])
     reach = pair_reach(R_UM * 1e-6, R_UM * 1e-6, 3)
@@ -160,7 +160,7 @@ def coalesce(
     started = time.perf_counter()
     for k in range(frames + 1):
         if k:
-            sim.advance(n)
+            sim.advance_to(sim.t + n * sim.dt)
         neck, length = pair_measures(sim, octant)
         now = sim.point_arrays(("volume0", "J"))
         vol = float((now["volume0"] * now["J"]).sum())

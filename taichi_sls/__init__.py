@@ -7,7 +7,7 @@ The Python API (README, "Python API")::
     case = sls.load_case("power25W", ["lasers.0.power_W=15"])  # a file or a bundled case
     summary = sls.run_case(case, "out/p15")   # every output, as the command line writes it
     sim = sls.Simulation(case)                # or step it yourself
-    sim.advance(1000); print(sim.monitors()["contact_line_um"])
+    sim.advance_to(5e-5); print(sim.monitors()["contact_line_um"])
 
 Names are imported on first use, so ``import taichi_sls`` loads neither Taichi nor Dask.
 """

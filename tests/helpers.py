@@ -17,7 +17,14 @@ PAPER_SCENE = {
     ],
 }
 
-__all__ = ["PAPER_SCENE", "deep_update", "guard_message", "make_case", "neck_and_kinetic_energy"]
+__all__ = [
+    "PAPER_SCENE",
+    "advance_steps",
+    "deep_update",
+    "guard_message",
+    "make_case",
+    "neck_and_kinetic_energy",
+]
 
 
 def make_case(data: dict):
@@ -38,13 +45,19 @@ def material_field(m):
     return f
 
 
+def advance_steps(sim, n: int) -> None:
+    """n steps of a fixed-step simulation, as ``Simulation.advance_to`` takes them (the whole
+    steps nearest to the time; an adaptive one lands on t + n dt)."""
+    sim.advance_to(sim.t + n * sim.dt)
+
+
 def neck_and_kinetic_energy(sim, every_s: float, frames: int) -> tuple[list, list]:
     """The contact line (um) and kinetic energy (J/m) after each of ``frames`` advances of
     ``every_s``, printed for the test log."""
     n = round(every_s / sim.dt)
     lines, ke = [], []
     for _ in range(frames):
-        sim.advance(n)
+        advance_steps(sim, n)
         m = sim.monitors()
         lines.append(m["contact_line_um"])
         ke.append(m["kinetic_energy_J_per_m"])
@@ -58,7 +71,7 @@ def guard_message(sim, frames: int = 1, steps: int = 0) -> str | None:
     from taichi_sls.solver.guard import SimulationError
 
     for _ in range(frames):
-        sim.advance(steps)
+        advance_steps(sim, steps)
         try:
             sim.monitors()
         except SimulationError as e:
@@ -92,7 +105,7 @@ def explicit_coarse_peak_C() -> float:
     from taichi_sls.solver.simulation import Simulation
 
     ref = Simulation(load_case("power25W_coarse", ["time.end_s=1e-4"]))
-    ref.advance(round(1e-4 / ref.dt))
+    ref.advance_to(1e-4)
     return ref.monitors()["T_peak_C"]
 
 

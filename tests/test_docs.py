@@ -82,7 +82,7 @@ def test_the_python_api_example_runs(tmp_path, monkeypatch):
     # the run's length (the fine pair's 4,000 steps to 2e-4 s cost a minute of the suite)
     code, n = re.subn(r"time\.end_s=[0-9.e+-]+", "time.end_s=2e-5", code)
     assert n == 1, "docs/running.md's example sets no time.end_s: it would run to 1 ms"
-    code = re.sub(r"sim\.advance\(\d+\)", "sim.advance(50)", code)
+    code = re.sub(r"sim\.advance_to\([0-9.e+-]+\)", "sim.advance_to(2.5e-6)", code)  # 50 steps
     monkeypatch.chdir(tmp_path)
     exec(compile(code, "running.md", "exec"), {})
     assert (tmp_path / "out" / "p15" / "summary.json").is_file()

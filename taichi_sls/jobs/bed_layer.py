@@ -96,7 +96,7 @@ def layer_density(sim: Simulation) -> dict[str, float]:
         half = 0.5 * cfg.h / sim.case.grid.points_per_cell
         ranges = [(float(x0[:, k].min()) - half, float(x0[:, k].max()) + half) for k in axes]
     return relative_density(
-        sim.raw_colour(), cfg.h, cfg.off, ranges, sim.case.domain.height_um * 1e-6
+        sim.necks.raw_colour(), cfg.h, cfg.off, ranges, sim.case.domain.height_um * 1e-6
     )
 
 

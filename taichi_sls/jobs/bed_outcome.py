@@ -12,7 +12,7 @@ Per contact (a, b) of ``Simulation.contacts``:
   ``fusion.neck_region_cells`` cells of the line through the contact point across the line of
   centres (and within the smaller radius of that point along it): for the pair of equal discs
   this is the region of the pair verdict;
-- the necks: ``Simulation.pair_necks_m``, on the colour of the two bodies alone; at the start,
+- the necks: ``Necks.pair_necks_m``, on the colour of the two bodies alone; at the start,
   at the last output frame in which the neck region held melt (a point with liquid fraction > 0:
   the neck as that contact's melting ends; NaN for a contact that never melted), and at the end;
 - melted through: ``fusion.melted_through`` of the region's points were fully molten at some
@@ -57,7 +57,7 @@ def is_bed(case: Case) -> bool:
 
 def contact_geometry(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
     """(contact points, unit vectors a -> b) of every contact (m), from the start centres."""
-    centre, radius = sim.body_centres_m(initial=True), sim.body_radii_m
+    centre, radius = sim.necks.body_centres_m(initial=True), sim.necks.body_radii_m
     points, normals = [], []
     for a, b in sim.contacts:
         d_vec = centre[b] - centre[a]
@@ -83,7 +83,7 @@ def neck_regions(sim: Simulation, points: np.ndarray, normals: np.ndarray) -> li
             across = np.abs(rel[:, 0] * e[1] - rel[:, 1] * e[0])
         else:  # the distance from the line of centres
             across = np.linalg.norm(rel - np.outer(rel @ e, e), axis=1)
-        reach = min(sim.body_radii_m[a], sim.body_radii_m[b])
+        reach = min(sim.necks.body_radii_m[a], sim.necks.body_radii_m[b])
         out.append((along <= half) & (across <= reach) & ((body == a) | (body == b)))
     return out
 
@@ -104,7 +104,7 @@ class ContactHistory:
         self.started = False
 
     def add(self, sim: Simulation) -> None:
-        necks = np.array(sim.pair_necks_m()) * 1e6
+        necks = np.array(sim.necks.pair_necks_m()) * 1e6
         liquid = 1.0 - sim.point_arrays(("solid_fraction",))["solid_fraction"]
         regions = neck_regions(sim, self.points, self.normals)
         self.molten_now = np.array([bool(np.any(liquid[r] > 0.0)) for r in regions], dtype=bool)

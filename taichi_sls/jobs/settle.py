@@ -25,7 +25,7 @@ from ..solver import struct_copy
 from ..solver.guard import SimulationError
 from ..solver.params import laser_arrays
 from ..solver.simulation import Simulation
-from .schedule import SETTLED_FRAMES, frame_steps, reached, settled, step_towards
+from .schedule import SETTLED_FRAMES, frame_steps, settled
 from .unheated import unheated_case
 
 
@@ -60,8 +60,7 @@ def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, floa
     before: deque[dict[str, float]] = deque(maxlen=SETTLED_FRAMES)
     done = False
     for frame_step in frame_steps(rule, sim.dt):
-        while not reached(sim, frame_step):
-            step_towards(sim, frame_step)
+        sim.advance_to(frame_step * sim.dt)
         before.append(last)
         last = sim.monitors()
         if progress:

@@ -47,10 +47,10 @@ def unheated_neck_um(case: Case) -> float:
     """The first contact's neck (um) at the end of the unheated run; NaN if it fails."""
     sim = Simulation(unheated_case(case))
     try:
-        if sim.adaptive is None:
-            sim.advance(math.ceil(case.fusion.baseline_s / sim.dt - 1e-9))
-        else:  # adaptive or hybrid: steps of their own size, landing on the time
-            sim.advance_to(case.fusion.baseline_s)
+        end = case.fusion.baseline_s  # adaptive or hybrid: steps of their own size, landing on it
+        if sim.adaptive is None:  # fixed steps: the whole ones that reach it
+            end = math.ceil(end / sim.dt - 1e-9) * sim.dt
+        sim.advance_to(end)
         return sim.monitors()["contact_line_um"]
     except SimulationError:  # the guard stopped it: the baseline is unknown
         return math.nan

@@ -20,7 +20,6 @@ shrink the next one.
 
 import enum
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,6 +33,7 @@ from .fields import POINT_MEMBERS, State, struct_type
 from .guard import SimulationError
 from .implicit import ImplicitStepper, NewtonError
 from .step import init_box
+from .stepper import NO_HOOKS, StepHooks
 
 SAFETY = 0.9  # aim a little below the controls, so that steady growth is rarely refused
 GROWTH = 2.0  # the most a step may grow over the last one
@@ -166,9 +166,10 @@ class AdaptiveStepper:
         self.changes = ti.Vector.field(4, float, ())
 
     def compile(self) -> None:
-        """Compile the kernels that judge a step (they change nothing the run reads before the
-        next step writes it), and the copy back that a refused step makes, so that the first
-        step does not pay for them."""
+        """Compile the implicit step's kernels, those that judge a step (they change nothing
+        the run reads before the next step writes it) and the copy back that a refused step
+        makes, so that the first step does not pay for them."""
+        self.implicit.compile()
         self.save()
         self.points_pass(PointsPass.RESTORE)
         self.changes_ratio(self.dt)
@@ -251,20 +252,18 @@ class AdaptiveStepper:
             )
         self.dt = max(self.controls.dt_min, min(smaller, dt))
 
-    def advance(self, n: int) -> None:
-        """n accepted steps."""
-        for _ in range(n):
-            if not self.step():
-                raise RuntimeError("AdaptiveStepper.advance: a hand-back needs the hybrid's loop")
-
-    def advance_to(self, t_end: float, after_step: Callable[[], None] | None = None) -> int:
-        """Steps until the clock reaches ``t_end`` (or a hand-back); returns how many were
-        taken."""
+    def advance_to(self, t_end: float, hooks: StepHooks = NO_HOOKS) -> int:
+        """Steps that land on ``t_end`` (s), or until a hand-back (the hybrid's explicit steps
+        take it; :meth:`hands_back`); returns how many were taken."""
         n = 0
         while float(self.st.scalars.t[None]) < t_end * (1.0 - 1e-12):
+            if self.hands_back():  # before a study's load, not after it
+                break
+            if hooks.before is not None:
+                hooks.before()
             if not self.step(t_end):
                 break
             n += 1
-            if after_step is not None:
-                after_step()
+            if hooks.after is not None:
+                hooks.after()
         return n

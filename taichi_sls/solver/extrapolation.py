@@ -26,6 +26,7 @@ from .adaptive import copy_points
 from .fields import POINT_MEMBERS, struct_type
 from .implicit import ImplicitStepper, StepReport
 from .step import init_box
+from .stepper import NO_HOOKS, StepHooks, fixed_steps_to, whole_steps
 
 # the points' members the extrapolation combines: the mechanics a step integrates
 EXTRAPOLATED = (
@@ -63,8 +64,8 @@ def extrapolate(now: ti.template(), whole: ti.template(), start: ti.template()) 
 
 class ExtrapolatedStepper:
     """Backward-Euler steps of one State, each taken whole and as two halves and extrapolated
-    (module docstring). Offers the :class:`ImplicitStepper` interface that the adaptive and
-    fixed-step loops use."""
+    (module docstring). Offers the :class:`ImplicitStepper` interface that the adaptive step
+    uses, and the stepper protocol (:mod:`taichi_sls.solver.stepper`)."""
 
     def __init__(self, inner: ImplicitStepper) -> None:
         self.inner = inner
@@ -83,6 +84,24 @@ class ExtrapolatedStepper:
     @property
     def newton_total(self) -> int:
         return self.inner.newton_total
+
+    @property
+    def dt(self) -> float:
+        """The fixed step of :meth:`advance_to` (s), the inner stepper's."""
+        return self.inner.dt
+
+    @dt.setter
+    def dt(self, dt: float) -> None:
+        self.inner.dt = dt
+
+    @property
+    def last_dt(self) -> float:
+        return self.inner.dt
+
+    def advance_to(self, t: float, hooks: StepHooks = NO_HOOKS) -> int:
+        """The whole steps of dt nearest to t (s) (:mod:`taichi_sls.solver.stepper`)."""
+        n = fixed_steps_to(float(self.st.scalars.t[None]), t, self.dt)
+        return whole_steps(self.advance, n, hooks)
 
     def compile(self) -> None:
         self.inner.compile(self)

@@ -35,6 +35,7 @@ from .adaptive import AdaptiveStepper, next_step
 from .fields import State
 from .scene import Scene
 from .step_config import step_config
+from .stepper import NO_HOOKS, ExplicitStepper, StepHooks, whole_steps
 from .time_step import (
     resolve_curvature_every,
     resolve_heat_every,
@@ -152,3 +153,44 @@ class Handover:
         if self.handbacks:
             self.adaptive.save()
         self.stretch, self.stretch_s = 0, t
+
+
+class HybridStepper:
+    """Explicit steps on the explicit view, then adaptive implicit ones, as the hand-over says
+    (module docstring; the stepper protocol, :mod:`taichi_sls.solver.stepper`)."""
+
+    def __init__(self, handover: Handover) -> None:
+        self.handover = handover
+        self.adaptive = handover.adaptive
+        self.explicit = ExplicitStepper(handover.view, handover.dt)
+
+    @property
+    def last_dt(self) -> float:
+        h = self.handover
+        return h.dt if h.explicit else self.adaptive.last_dt
+
+    def compile(self) -> None:
+        self.explicit.compile()
+        self.adaptive.compile()
+
+    def _t(self) -> float:
+        return float(self.adaptive.st.scalars.t[None])
+
+    def advance_to(self, t: float, hooks: StepHooks = NO_HOOKS) -> int:
+        """Until the clock reaches t (s): adaptive steps that land on it, or, in an explicit
+        phase, the whole explicit steps that reach it (after a hand-back the clock is off their
+        grid; on it, the ones that land on it), a check of the hand-over every
+        :meth:`Handover.steps_to_check` of them. Returns the steps taken."""
+        h, taken = self.handover, 0
+        while self._t() < t * (1.0 - 1e-12):
+            if h.explicit:
+                if (n := math.ceil((t - self._t()) / h.dt - 1e-6)) <= 0:
+                    break
+                k = min(n, h.steps_to_check())
+                taken += whole_steps(self.explicit.take, k, hooks)
+                h.check(self._t(), k)
+                continue
+            taken += self.adaptive.advance_to(t, hooks)
+            if self._t() < t * (1.0 - 1e-12):  # stopped short: the explicit steps take over
+                h.hand_back(self._t())
+        return taken

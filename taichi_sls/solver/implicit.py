@@ -66,6 +66,7 @@ from .step import (
     surface_force,
     watch,
 )
+from .stepper import NO_HOOKS, StepHooks, fixed_steps_to, whole_steps
 
 # the stages of the explicit step that the implicit one runs before its Newton loop
 BEFORE = (clear_grid, p2g, surface_force)
@@ -234,9 +235,11 @@ def end(st: ti.template()):
 class ImplicitStepper:
     """Backward-Euler steps of one State (module docstring)."""
 
-    def __init__(self, case: Case, st: State, heat_substeps: int) -> None:
+    def __init__(self, case: Case, st: State, heat_substeps: int, dt: float | None = None) -> None:
         self.case = case
         self.st = st
+        # the fixed step of advance_to (s; default the state's): the whole steps nearest to t
+        self.dt = float(st.scalars.dt[None]) if dt is None else dt
         self.heat = StepHeat(case, st, heat_substeps)  # 0 substeps: no heat
         self.tol = case.time.newton_tolerance
         self.max_iterations = case.time.newton_max_iterations
@@ -249,6 +252,15 @@ class ImplicitStepper:
     def advance(self, n: int) -> None:
         for _ in range(n):
             self.step()
+
+    @property
+    def last_dt(self) -> float:
+        return self.dt
+
+    def advance_to(self, t: float, hooks: StepHooks = NO_HOOKS) -> int:
+        """The whole steps of dt nearest to t (s) (:mod:`taichi_sls.solver.stepper`)."""
+        n = fixed_steps_to(float(self.st.scalars.t[None]), t, self.dt)
+        return whole_steps(self.advance, n, hooks)
 
     def compile(self, stepper: "ImplicitStepper | None" = None) -> None:
         """Compile every kernel of the step (of ``stepper``'s, which wraps this one) by taking

@@ -1,13 +1,17 @@
-"""The interface and neck measures of a simulation (a mixin of :class:`Simulation`): the level
-set and colour on the nodes, the contact line of the paper's pair, the neck of every contact."""
+"""The interface and neck measures of a simulation's state: the level set and colour on the
+nodes, the contact line of the paper's pair, the neck of every contact."""
+
+from __future__ import annotations
 
 import numpy as np
 
+from ..config import Case
 from . import struct_copy
 from .contacts import point_colour
+from .fields import State
 from .grid_views import interface_fields
 from .monitor import neck_measures
-from .neck_section import filtered_colour, neck_section, pair_reach
+from .neck_section import equivalent_radii, filtered_colour, neck_section, pair_reach
 
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
 # own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
@@ -15,14 +19,31 @@ HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
 HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
 
 
-class NeckMeasures:
-    """Needs ``case``, ``state``, ``scene``, ``contacts``, ``_pair``, ``_mass`` and
-    ``_body_radius`` (set by :class:`Simulation`)."""
+def point_arrays(st: State, keys: tuple[str, ...] = HOST_POINT_MEMBERS) -> dict[str, np.ndarray]:
+    """The points' members the host reads (default HOST_POINT_MEMBERS), copied by the one
+    kernel that copies any of them."""
+    return struct_copy.to_numpy(st.points, keys)
 
-    def point_arrays(self, keys: tuple[str, ...] = HOST_POINT_MEMBERS) -> dict[str, np.ndarray]:
-        """The points' members the host reads (default HOST_POINT_MEMBERS), copied by the one
-        kernel that copies any of them."""
-        return struct_copy.to_numpy(self.state.points, keys)
+
+class Necks:
+    """The neck measures of ``st`` (its points in the order of ``st.scene``, which the blocks
+    layout sorts again: :meth:`reorder` follows) for ``contacts``, the pairs of touching bodies
+    as seeded."""
+
+    def __init__(self, case: Case, st: State, contacts: list[tuple[int, int]]) -> None:
+        self.case = case
+        self.state = st
+        self.contacts = contacts
+        self.pair = len(case.bodies) >= 2  # a contact line to read: the paper's pair
+        self.mass = point_arrays(st)["mass"]  # each point's, in the points' order
+        sc = st.scene
+        # each body's equivalent radius as seeded, sqrt(area / pi) (3D: (3 V / 4 pi)^(1/3)):
+        # its reach for a neck (m)
+        self.body_radii_m = equivalent_radii(sc.body, sc.vol, case.domain.dim)
+
+    def reorder(self, order: np.ndarray) -> None:
+        """The points were put in the order ``order`` (the state's scene with them)."""
+        self.mass = self.mass[order]
 
     def node_arrays(self) -> dict[str, np.ndarray]:
         """The node fields the neck measures read (HOST_NODE_MEMBERS), copied by one kernel."""
@@ -55,7 +76,7 @@ class NeckMeasures:
         """(contact line, neck span) in metres of the first contact (the paper's pair) on
         ``measure`` (default: :meth:`neck_measure`), sectioned as ``contact.neck_section`` says
         (:meth:`necks_m`; the column: :mod:`taichi_sls.solver.monitor`)."""
-        if not self._pair:
+        if not self.pair:
             return float("nan"), float("nan")
         measure = measure or self.neck_measure()
         if measure == "level_set" and self.state.cfg.dim == 3:
@@ -68,7 +89,7 @@ class NeckMeasures:
             return w, w
         lo, hi = sorted(self.body_centres_m()[:2, 0])
         cfg = self.state.cfg
-        return neck_measures(-self._material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
+        return neck_measures(-self.material_field(measure, "column"), cfg.h, cfg.off, lo, hi)
 
     def raw_colour(self) -> np.ndarray:
         """The colour c_i of the current points before any filter: the cell fraction that
@@ -79,7 +100,7 @@ class NeckMeasures:
             return nd["volume"] / cfg.cell_volume
         return nd["mass"] / (cfg.rho_ref * cfg.cell_volume)
 
-    def _material_field(self, measure: str, section: str) -> np.ndarray:
+    def material_field(self, measure: str, section: str) -> np.ndarray:
         """The interface field on the nodes, material where it is >= 0: -phi of eq. 21, or
         c - 1/2 of the colour. The column reads the colour the force contours; the sections
         across the centres the colour ``contact.neck_colour`` names (:meth:`section_colour`)."""
@@ -103,7 +124,7 @@ class NeckMeasures:
         interface (:func:`taichi_sls.solver.neck_section.neck_section`), out to the pair's reach."""
         if not self.contacts:
             return []
-        field = self._material_field(measure or self.neck_measure(), "centres")
+        field = self.material_field(measure or self.neck_measure(), "centres")
         return self._contact_necks(lambda a, b: field)
 
     def _contact_necks(self, field_of) -> list[float]:
@@ -111,7 +132,7 @@ class NeckMeasures:
         :func:`~taichi_sls.solver.neck_section.pair_reach`: the coalesced end state of the
         pair, so a neck is followed past the bodies' initial diameter (issue #40 item 6). 3D:
         the diameter 2 sqrt(A / pi) of the section."""
-        centre, r, cfg = self.body_centres_m(), self._body_radius, self.state.cfg
+        centre, r, cfg = self.body_centres_m(), self.body_radii_m, self.state.cfg
         return [
             neck_section(
                 field_of(a, b),
@@ -124,18 +145,12 @@ class NeckMeasures:
             for a, b in self.contacts
         ]
 
-    @property
-    def body_radii_m(self) -> np.ndarray:
-        """Each body's equivalent radius as seeded (m), sqrt(area / pi) (3D: (3 V / 4 pi)^(1/3)):
-        its reach for a neck."""
-        return self._body_radius
-
     def body_centres_m(self, initial: bool = False) -> np.ndarray:
         """Each body's mass centre (m), (bodies, dim): of the current points, or (``initial``) of
         their start positions."""
-        x = self.point_arrays()["x0" if initial else "x"]
-        body, m = self.scene.body, self._mass
-        n_b = len(self._body_radius)
+        x = point_arrays(self.state)["x0" if initial else "x"]
+        body, m = self.state.scene.body, self.mass
+        n_b = len(self.body_radii_m)
         return (
             np.stack(
                 [np.bincount(body, weights=m * x[:, k], minlength=n_b) for k in range(x.shape[1])],
@@ -149,9 +164,9 @@ class NeckMeasures:
         unit weight: m / (rho V_cell) for the mass colour, V0 J / V_cell for the volume one."""
         cfg = self.state.cfg
         if cfg.se.volume_colour:
-            pt = self.point_arrays(("volume0", "J"))
+            pt = point_arrays(self.state, ("volume0", "J"))
             return pt["volume0"] * pt["J"] / cfg.cell_volume
-        return self._mass / (cfg.rho_ref * cfg.cell_volume)
+        return self.mass / (cfg.rho_ref * cfg.cell_volume)
 
     def pair_necks_m(self) -> list[float]:
         """The neck of every contact (m), in the order of ``contacts``, read as :meth:`necks_m`
@@ -163,11 +178,11 @@ class NeckMeasures:
         if not self.contacts:
             return []
         cfg = self.state.cfg
-        x, weight = self.point_arrays(("x",))["x"], self.colour_weights()
-        body = self.scene.body
+        x, weight = point_arrays(self.state, ("x",))["x"], self.colour_weights()
+        body = self.state.scene.body
         order = np.argsort(body, kind="stable")
-        bounds = np.searchsorted(body[order], np.arange(len(self._body_radius) + 1))
-        members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self._body_radius))]
+        bounds = np.searchsorted(body[order], np.arange(len(self.body_radii_m) + 1))
+        members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self.body_radii_m))]
         shape = (cfg.nx, cfg.ny) if cfg.dim == 2 else (cfg.nx, cfg.ny, cfg.nz)
 
         def colour(a: int, b: int) -> np.ndarray:

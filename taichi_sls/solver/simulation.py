@@ -20,15 +20,15 @@ from .contacts import touching
 from .extrapolation import ExtrapolatedStepper
 from .fields import State
 from .guard import Guard, temperature_floor_K
-from .handover import Handover, explicit_view
+from .handover import Handover, HybridStepper, explicit_view
 from .implicit import ImplicitStepper
 from .monitor import point_monitors
-from .neck_section import equivalent_radii
-from .necks import NeckMeasures
+from .necks import HOST_POINT_MEMBERS, Necks, point_arrays
 from .params import laser_arrays, material_arrays
 from .scene import Scene, build_scene
-from .step import advance, init_box
+from .step import init_box
 from .step_config import Layout, choose_layout, step_config
+from .stepper import ExplicitStepper, StepHooks, Stepper
 from .time_step import (
     heat_step_max,
     resolve_curvature_every,
@@ -69,9 +69,10 @@ def init_taichi(
     )
 
 
-class Simulation(NeckMeasures):
-    """One case on the device: ``advance(n)`` steps, ``monitors()`` reads (and guards) the
-    state, ``snapshot()`` gives the points for output.
+class Simulation:
+    """One case on the device: ``advance_to(t)`` steps, ``monitors()`` reads (and guards) the
+    state, ``necks`` measures the interface and the necks, ``snapshot()`` gives the points for
+    output.
 
     ``scene``: the points to use instead of seeding the case's bodies (studies set initial
     fields through it; the speed benchmark passes them shuffled). ``before_step``: called with
@@ -126,7 +127,7 @@ class Simulation(NeckMeasures):
         hybrid = case.time.integrator == "hybrid"
         if cfg.implicit:
             self.state.scalars.dt_heat[None] = dt_heat
-            self.implicit = ImplicitStepper(case, self.state, self.heat_substeps)
+            self.implicit = ImplicitStepper(case, self.state, self.heat_substeps, self.dt)
             if case.time.implicit_scheme == "extrapolated":
                 self.implicit = ExtrapolatedStepper(self.implicit)
             if case.step_adapts():  # hybrid: from implicit_step_factor x its dt
@@ -139,16 +140,20 @@ class Simulation(NeckMeasures):
         if hybrid:
             view = explicit_view(case, self.state, self.scene, self.dt)
             self.handover = Handover(case, view, self.adaptive, self.dt, self.kinetic_ratio)
-        if self.implicit is None or hybrid:
-            advance(self.explicit_state, 0)  # compiles the explicit step kernel
-        if self.implicit is not None:
-            self.implicit.compile()
-        if self.adaptive is not None:
-            self.adaptive.compile()
+        # the one stepper that advance_to drives (solver/stepper.py)
+        self.stepper: Stepper = (
+            HybridStepper(self.handover)
+            if hybrid
+            else self.adaptive or self.implicit or ExplicitStepper(self.state, self.dt)
+        )
+        self.stepper.compile()
         # every kernel compiled in the constructor (the field layout's included); later ones
         # (settle, hand-over) count in run_case's summary through the same clock
         self.compile_s = compile_clock.since(clock0)["compile_s"]
-        self._mass = self.point_arrays()["mass"]
+        # the contacts, found once on the seeded points, and their neck measures
+        sc = self.scene
+        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell)
+        self.necks = Necks(case, self.state, self.contacts)
         # each point's index in the order the run started with: the blocks layout sorts the
         # points again as they flow, and a checkpoint keeps that order
         self.point_order = np.arange(self.scene.n_points)
@@ -160,13 +165,12 @@ class Simulation(NeckMeasures):
             T_floor_K=temperature_floor_K(case, cfg.dim, float(self.scene.T0_C.min())),
             energy_tol=1e-6 if case.solver.precision == "f64" else 1e-3,
         )
-        self._pair = len(case.bodies) >= 2
-        # the contacts, found once on the seeded points; each body's equivalent radius (reach)
-        sc = self.scene
-        self.contacts = touching(sc.x, sc.body, sc.h / case.grid.points_per_cell)
-        self._body_radius = equivalent_radii(sc.body, sc.vol, case.domain.dim)
         self._H0: float | None = None  # enthalpy at step 0, for the energy-balance check
         self._e_static: float | None = None  # the step-independent part of energy_bound
+
+    def point_arrays(self, keys: tuple[str, ...] = HOST_POINT_MEMBERS) -> dict[str, np.ndarray]:
+        """The points' members the host reads (default HOST_POINT_MEMBERS), by one kernel."""
+        return point_arrays(self.state, keys)
 
     @property
     def t(self) -> float:
@@ -185,24 +189,15 @@ class Simulation(NeckMeasures):
     @property
     def step_dt(self) -> float:
         """The last step taken (s): ``dt`` but with ``time.adaptive`` or after a hand-over."""
-        return self.dt if self.adaptive is None or self.explicit_now else self.adaptive.last_dt
+        return self.stepper.last_dt
 
     def advance_to(self, t: float) -> None:
         """Advance until the clock reaches t (s): adaptive steps that land on it, or the whole
-        fixed steps nearest to it (hybrid, explicit after a hand-back: those that reach it)."""
-        if self.adaptive is None:
-            self.advance(round((t - self.t) / self.dt))
-            return
-        while self.t < t * (1.0 - 1e-12):
-            if self.explicit_now:  # after a hand-back the clock is off the explicit steps'
-                # grid: the whole steps that reach t (on the grid, the ones that land on it)
-                if (n := math.ceil((t - self.t) / self.dt - 1e-6)) <= 0:
-                    return
-                self._explicit_steps(n)
-                continue
-            self.steps += self.adaptive.advance_to(t, self._after_step)
-            if self.t < t * (1.0 - 1e-12):  # stopped short: the explicit steps take over
-                self.handover.hand_back(self.t)
+        fixed steps nearest to it (hybrid, explicit after a hand-back: those that reach it).
+        The one stepping verb: the case's stepper (solver/stepper.py) takes the steps."""
+        before = None if self.before_step is None else lambda: self.before_step(self)
+        after = None if self.blocks is None else self._after_step
+        self.steps += self.stepper.advance_to(t, StepHooks(before, after))
 
     def restart_clock(self) -> None:
         """t = 0 at the state reached (contact.settle): the step count, the points' start
@@ -224,55 +219,8 @@ class Simulation(NeckMeasures):
         return self.case.solver.mass_scale * kinetic_energy / self.surface_energy()
 
     def _after_step(self) -> None:
-        if self.blocks is not None and self.blocks.needs_sort[None]:
+        if self.blocks.needs_sort[None]:  # a point drifted out of its block: sort them again
             self.sort_points()
-
-    def advance(self, n: int) -> None:
-        """Advance n steps (hybrid: explicit or implicit ones, as the hand-over says)."""
-        if self.handover is None:
-            stepper = self.adaptive or self.implicit
-            step = advance if stepper is None else lambda st, k: stepper.advance(k)
-            self._advance(step, None, n)
-            return
-        while n > 0:
-            if self.handover.explicit:
-                n -= self._explicit_steps(n)
-                continue
-            if self.adaptive.hands_back():  # before the study's load, not after it
-                self.handover.hand_back(self.t)
-                continue
-            if self.before_step is not None:
-                self.before_step(self)
-            if self.adaptive.step():
-                self.steps += 1
-                n -= 1
-                self._after_step()
-            else:
-                self.handover.hand_back(self.t)
-
-    def _explicit_steps(self, n: int) -> int:
-        """Hybrid: explicit steps, at most n, up to the next check of the hand-over."""
-        k = min(n, self.handover.steps_to_check())
-        self._advance(advance, self.handover.view, k)
-        self.handover.check(self.t, k)
-        return k
-
-    def _advance(self, step: Callable, state: State | None, n: int) -> None:
-        """n steps of ``step(state, n)`` (default state: the run's), sorting the blocks."""
-        if n <= 0:
-            return
-        state = state or self.state
-        if self.before_step is not None:
-            for _ in range(n):
-                self.before_step(self)
-                step(state, 1)
-        elif self.blocks is not None:
-            for _ in range(n):  # a point that drifted out of its block: sort them again
-                step(state, 1)
-                self._after_step()
-        else:
-            step(state, n)
-        self.steps += n
 
     def sort_points(self) -> None:
         """Blocks layout: the points sorted by block again (every per-point array and the
@@ -288,7 +236,7 @@ class Simulation(NeckMeasures):
         struct_copy.from_numpy(pt, {k: v[order] for k, v in struct_copy.to_numpy(pt).items()})
         self.scene = self.scene.reordered(order)
         self.state.scene = self.scene
-        self._mass = self._mass[order]
+        self.necks.reorder(order)
         self.point_order = self.point_order[order]
 
     # ------------------------------------------------------------------ monitors
@@ -306,11 +254,11 @@ class Simulation(NeckMeasures):
         # inertia against the surface energy: small when the flow is quasi-static (the rule of
         # solver.mass_scale and of the settled state of time.stop = "solidified")
         out["kinetic_ratio"] = self.kinetic_ratio(out["kinetic_energy_J_per_m"])
-        cl, span = self.contact_line_m()
+        cl, span = self.necks.contact_line_m()
         out["contact_line_um"] = cl * 1e6
         out["neck_span_um"] = span * 1e6
-        if self.neck_measure() == "colour":  # the paper's measure (Fig. 4) beside it
-            out["contact_line_level_set_um"] = self.contact_line_m("level_set")[0] * 1e6
+        if self.necks.neck_measure() == "colour":  # the paper's measure (Fig. 4) beside it
+            out["contact_line_level_set_um"] = self.necks.contact_line_m("level_set")[0] * 1e6
         if self.steps == 0 and self._H0 is None:
             self._H0 = out["enthalpy_J_per_m"]
         if guard:
@@ -339,9 +287,9 @@ class Simulation(NeckMeasures):
         if self._e_static is None:
             c = self.case
             gamma = max(m.surface_tension_N_m for m in c.materials.values())
-            g, M = math.hypot(*c.physics.gravity_m_s2), float(self._mass.sum())
+            g, M = math.hypot(*c.physics.gravity_m_s2), float(self.necks.mass.sum())
             v0 = self.point_arrays()["v"]
-            ke0 = 0.5 * float((self._mass * (v0**2).sum(axis=1)).sum())
+            ke0 = 0.5 * float((self.necks.mass * (v0**2).sum(axis=1)).sum())
             surface = gamma * c.outline_um() * 1e-6 ** (c.domain.dim - 1)
             self._e_static = ke0 + surface + M * g * self.scene.height
         return self._e_static + float(self.state.scalars.laser_energy[None])
@@ -377,7 +325,7 @@ class Simulation(NeckMeasures):
             self.adaptive.dt = float(extra.pop("adaptive_dt"))
         if self.handover is None:
             if self.adaptive is None:
-                self.dt = float(self.state.scalars.dt[None])
+                self.dt = self.stepper.dt = float(self.state.scalars.dt[None])
             # else dt stays the run's first step: the frame times are its multiples (the
             # checkpoint's dt is the last adaptive step; taken as dt it moved every later frame)
             return extra

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import advance_steps
 
 from bench.sphere_pair_report import (
     END_STATE,
@@ -44,7 +45,7 @@ def test_the_octant_runs_the_whole_pair():
     for octant in (True, False):
         case = sphere_pair_case(4.0, 0.02, octant=octant, on_nodes=True)
         sim = Simulation(case)
-        sim.advance(400)
+        advance_steps(sim, 400)
         results.append(
             (pair_measures(sim, octant), sim.point_arrays(("volume0",))["volume0"].sum())
         )

@@ -6,7 +6,7 @@ randomized run found the guard's NaN-location bug (fixed, tests/test_run.py)."""
 import math
 
 import pytest
-from helpers import PAPER_SCENE, deep_update
+from helpers import PAPER_SCENE, advance_steps, deep_update
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -140,7 +140,7 @@ def test_extreme_cases_run_or_stop_with_our_error(power, radius, E, nu, gamma, d
     sim = Simulation(case)
     try:
         for _ in range(3):
-            sim.advance(20)
+            advance_steps(sim, 20)
             sim.monitors()
     except SimulationError as e:
         assert "likely cause" in str(e)

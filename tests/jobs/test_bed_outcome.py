@@ -177,8 +177,8 @@ def test_pair_colour_is_the_steps_p2g(tmp_path):
     x = sim.state.points.x.to_numpy()
     weight = sim.state.points.mass.to_numpy() / (cfg.rho_ref * cfg.cell_volume)
     mine = point_colour(x, weight, cfg.h, cfg.lp, cfg.off, (cfg.nx, cfg.ny))
-    assert np.abs(mine - sim.raw_colour()).max() < 1e-12
-    assert len(sim.pair_necks_m()) == len(TANGENT)
+    assert np.abs(mine - sim.necks.raw_colour()).max() < 1e-12
+    assert len(sim.necks.pair_necks_m()) == len(TANGENT)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -226,8 +226,9 @@ def test_a_pairs_contact_region_is_the_pair_verdicts_neck_region():
         case=case,
         contacts=[(0, 1)],
         scene=sc,
-        body_radii_m=np.sqrt(area / np.pi),
-        body_centres_m=lambda initial: centres,
+        necks=SimpleNamespace(
+            body_radii_m=np.sqrt(area / np.pi), body_centres_m=lambda initial: centres
+        ),
         point_arrays=lambda keys: {"x0": sc.x},
         state=SimpleNamespace(cfg=SimpleNamespace(h=case.grid.spacing_um * 1e-6)),
     )

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import deep_update, make_case, material_field
+from helpers import advance_steps, deep_update, make_case, material_field
 from test_thermal import INSULATED, MELT_RANGE
 
 from taichi_sls.backend import ti
@@ -214,9 +214,9 @@ def test_kinetics_block_melt_lives_until_the_kinetics_crystallise_it(speedup):
     sim = Simulation(_cooling_block(160.0, kin))
     assert sim.state.cfg.kinetics and sim.state.cfg.hysteresis
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(int(round(2e-4 / sim.dt)))
+    advance_steps(sim, int(round(2e-4 / sim.dt)))
     molten = sim.state.points.solid_fraction.to_numpy() == 0.0
-    sim.advance(int(round(6e-3 / sim.dt)))
+    advance_steps(sim, int(round(6e-3 / sim.dt)))
     m = sim.monitors()
     pt = sim.state.points
     T, xi = pt.T.to_numpy() - KELVIN, pt.solid_fraction.to_numpy()

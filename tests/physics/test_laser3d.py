@@ -6,7 +6,7 @@ for a stationary spot and for hatched tracks in the bed."""
 import math
 
 import pytest
-from helpers import make_case
+from helpers import advance_steps, make_case
 
 from taichi_sls.solver.simulation import Simulation
 
@@ -63,7 +63,7 @@ def test_spot_power_integrates_to_the_absorbed_power(dim):
     energy delivered to 1e-9 relative."""
     sim = _block(dim, [_spot()])
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(round(ON_S / sim.dt) + 3)  # past the switch-off
+    advance_steps(sim, round(ON_S / sim.dt) + 3)  # past the switch-off
     m = sim.monitors()
     plane = A * P if dim == 3 else A * P * math.sqrt(2 / math.pi) / (R0_UM * 1e-6)
     eta = ETA_UM * 1e-6
@@ -90,7 +90,7 @@ def test_hatched_tracks_in_3d_balance_the_enthalpy():
     per_track = []
     for _ in range(3):
         before = sim.monitors()["laser_energy_J_per_m"]
-        sim.advance(round(ret / sim.dt))
+        advance_steps(sim, round(ret / sim.dt))
         per_track.append(sim.monitors()["laser_energy_J_per_m"] - before)
     m = sim.monitors()
     got = m["laser_energy_J_per_m"]
@@ -135,7 +135,7 @@ def _gap(dim: int, surface: str, upper: bool) -> float:
         for b in data["bodies"]:
             b["min_um"], b["max_um"] = [*b["min_um"], 0.0], [*b["max_um"], 40.0]
     sim = Simulation(make_case(data))
-    sim.advance(round(ON_S / sim.dt) + 3)
+    advance_steps(sim, round(ON_S / sim.dt) + 3)
     return sim.monitors()["laser_energy_J_per_m"]
 
 

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import deep_update, make_case, material_field
+from helpers import advance_steps, deep_update, make_case, material_field
 
 from taichi_sls.backend import ti
 from taichi_sls.config import Material
@@ -71,7 +71,7 @@ def test_free_body_conserves_mass_and_momentum(transfer):
     v = st.points.v.to_numpy() + 2e4 * np.stack([-(x[:, 1] - c[1]), x[:, 0] - c[0]], axis=1)
     st.points.v.from_numpy(v)
     p0 = (m[:, None] * v).sum(axis=0)
-    sim.advance(300)
+    advance_steps(sim, 300)
     p1 = (m[:, None] * st.points.v.to_numpy()).sum(axis=0)
     # round-off only: 300 steps of sums over ~800 points, against the momentum scale sum m |v|
     scale = (m * np.linalg.norm(v, axis=1)).sum()
@@ -169,7 +169,7 @@ def test_musl_conserves_momentum():
     st = sim.state
     m = st.points.mass.to_numpy()
     p0 = (m[:, None] * st.points.v.to_numpy()).sum(axis=0)
-    sim.advance(200)
+    advance_steps(sim, 200)
     p1 = (m[:, None] * st.points.v.to_numpy()).sum(axis=0)
     np.testing.assert_allclose(p1, p0, rtol=1e-12)
 
@@ -261,7 +261,7 @@ def _noise_left(blend_per: str, dt: float, t_end: float = 5e-7) -> float:
     v = np.random.default_rng(3).normal(0.0, 0.01, st.points.v.to_numpy().shape)
     st.points.v.from_numpy(v)
     m = st.points.mass.to_numpy()[:, None]
-    sim.advance(int(round(t_end / dt)))
+    advance_steps(sim, int(round(t_end / dt)))
     return float((m * st.points.v.to_numpy() ** 2).sum() / (m * v**2).sum())
 
 

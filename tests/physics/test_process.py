@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import deep_update, make_case
+from helpers import advance_steps, deep_update, make_case
 from scipy.optimize import brentq
 from scipy.special import erf
 
@@ -74,7 +74,7 @@ def test_hatches_deliver_the_andrew_number():
     H0 = sim.monitors()["enthalpy_J_per_m"]
     end = case.lasers_off_s()
     assert end == pytest.approx(2 * 3 * 30e-6 / 5.0 + 2 * 4e-5)
-    sim.advance(int(math.ceil(end / sim.dt)) + 2)
+    advance_steps(sim, int(math.ceil(end / sim.dt)) + 2)
     m = sim.monitors()
     got = m["laser_energy_J_per_m"]
     exact = _delivered_exact(HATCH)
@@ -101,7 +101,7 @@ def test_hatch_energy_does_not_depend_on_the_step():
         case = make_case(deep_update(_hatch_case().model_dump(), {"time": {"dt_s": dt}}))
         sim = Simulation(case)
         sim.state.scalars.dt[None] = dt  # heat only: the step as asked, not the stable one
-        sim.advance(int(math.ceil(case.lasers_off_s() / dt)) + 1)
+        advance_steps(sim, int(math.ceil(case.lasers_off_s() / dt)) + 1)
         out.append(sim.monitors()["laser_energy_J_per_m"])
     print("energies:", out)
     assert out[1] == pytest.approx(out[0], rel=1e-9)
@@ -208,7 +208,7 @@ def test_top_loss_first_step_is_the_flux_times_the_width(layout):
     )
     assert sim.state.cfg.layout.name == layout.upper()
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(1)
+    advance_steps(sim, 1)
     m = sim.monitors()
     T, Tc = 200.0 + KELVIN, 172.0 + KELVIN
     q = 15.0 * (T - Tc) + 0.92 * STEFAN_BOLTZMANN * (T**4 - Tc**4)
@@ -269,7 +269,7 @@ def test_a_long_step_never_cools_a_thin_skin_past_the_chamber():
     )
     assert sim.state.cfg.heat_implicit
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(1)
+    advance_steps(sim, 1)
     assert sim.dt == 1.0
     m = sim.monitors()
     T, Tc = 200.0 + KELVIN, 172.0 + KELVIN
@@ -299,7 +299,7 @@ def test_the_guard_floor_is_the_coldest_start_wall_or_chamber():
 def test_top_loss_default_is_insulated():
     sim = Simulation(_slab_case({"initial_C": 200.0}))
     assert not sim.state.cfg.top_loss
-    sim.advance(5)
+    advance_steps(sim, 5)
     assert sim.monitors()["heat_out_J_per_m"] == 0.0
 
 
@@ -340,7 +340,7 @@ def _cool_for_20ms(sim: Simulation) -> tuple[float, float, float]:
     """Step the slab from 200 C (Bi = 0.3 to 170 C) for 20 ms: (mean temperature, the exact
     series' mean, t)."""
     n = int(round(20e-3 / sim.dt))
-    sim.advance(n)
+    advance_steps(sim, n)
     t = n * sim.dt
     pt = sim.state.points
     mass = pt.mass.to_numpy()
@@ -394,7 +394,7 @@ def test_top_loss_in_3d_first_step_is_the_flux_times_the_area(layout, periodic):
         _slab3d_case({"initial_C": 200.0, "convection_W_m2K": 15.0, **chamber}, periodic, layout)
     )
     H0 = sim.monitors()["enthalpy_J_per_m"]  # J in 3D (the CSV names it enthalpy_J)
-    sim.advance(1)
+    advance_steps(sim, 1)
     m = sim.monitors()
     T, Tc = 200.0 + KELVIN, 172.0 + KELVIN
     q = 15.0 * (T - Tc) + 0.92 * STEFAN_BOLTZMANN * (T**4 - Tc**4)

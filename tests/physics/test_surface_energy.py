@@ -128,7 +128,9 @@ def test_hopper_shape_seeds_the_exact_outline():
         assert sc.vol.sum() / (2 * math.pi * R0**2) == pytest.approx(1.0, abs=0.01)
         sim = Simulation(vc.case)
         _, X = hopper_layout(vc.case)
-        rn.append(0.5 * colour_section(sim.colour(), sim.state.cfg.h, sim.state.cfg.off, X) / R0)
+        rn.append(
+            0.5 * colour_section(sim.necks.colour(), sim.state.cfg.h, sim.state.cfg.off, X) / R0
+        )
     assert 0.30 < rn[0] < rn[1] < 0.50
 
 
@@ -154,9 +156,9 @@ def test_colour_contact_line_of_the_paper_pair():
         m = sim.monitors()
         cls.append(m["contact_line_um"])
         assert m["contact_line_level_set_um"] == pytest.approx(8.27, abs=0.01)
-        across.append(sim.necks_m("colour")[0] * 1e6)
+        across.append(sim.necks.necks_m("colour")[0] * 1e6)
         sim.case.contact.neck_colour = "raw"
-        across_raw.append(sim.necks_m("colour")[0] * 1e6)
+        across_raw.append(sim.necks.necks_m("colour")[0] * 1e6)
     assert cls[0] == pytest.approx(13.58, abs=0.05)
     assert cls[1] == pytest.approx(9.33, abs=0.05)
     assert across == pytest.approx([13.58, 13.58], abs=0.05)
@@ -167,7 +169,7 @@ def test_surface_energy_is_the_default_and_csf_stays_reachable():
     vc = ver.load("laplace", 10)
     assert vc.case.surface_tension.method == "surface_energy"
     csf = Simulation(ver.load("laplace", 10, {"surface_tension": {"method": "csf"}}).case)
-    assert csf.neck_measure() == "level_set" and csf.curvature_every >= 1
+    assert csf.necks.neck_measure() == "level_set" and csf.curvature_every >= 1
 
 
 def test_laplace_pressure_and_spurious_currents():
@@ -224,7 +226,7 @@ def test_hopper_from_touching_discs_R0_h_20():
     shared cores).
 
     The same run read by the per-contact section the process results rest on
-    (``Simulation.necks_m``: reach ``pair_reach``, the filtered colour of
+    (``Necks.necks_m``: reach ``pair_reach``, the filtered colour of
     ``contact.neck_colour``; issue #40 item 6): within 3 % (that item's bar) at all four times,
     past the discs' initial diameter from tau ~1.45 on (measured -2.87 / -2.11 / -0.38 /
     -0.10 %; 25 min on two crowded cores; the raw colour read -13.5 / -4.7 / -0.36 / +0.40 %:

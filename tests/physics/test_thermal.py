@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from helpers import PAPER_SCENE, deep_update, make_case, material_field
+from helpers import PAPER_SCENE, advance_steps, deep_update, make_case, material_field
 
 from taichi_sls.backend import ti
 from taichi_sls.config import Material
@@ -59,7 +59,7 @@ def test_energy_balance_insulated_to_round_off():
 def test_energy_balance_with_fixed_baseplate():
     sim = Simulation(_laser_case(True))
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(400)
+    advance_steps(sim, 400)
     m = sim.monitors()
     rise = m["enthalpy_J_per_m"] - H0
     assert m["heat_out_J_per_m"] > 0  # the plate takes heat
@@ -116,7 +116,7 @@ def test_free_thermal_expansion_is_stress_free():
     sim = Simulation(case)
     st = sim.state
     T0 = st.points.T.to_numpy().mean()
-    sim.advance(int(round(1e-4 / sim.dt)))
+    advance_steps(sim, int(round(1e-4 / sim.dt)))
     dT = st.points.T.to_numpy().mean() - T0
     assert dT > 5.0
     F = st.points.F.to_numpy()
@@ -139,7 +139,7 @@ def test_laser_per_kg_reading_is_rho_times_larger():
         case.lasers[0].power_W = 0.01
         case.physics.mechanics = False  # frozen points: same volumes in both runs
         sim = Simulation(case)
-        sim.advance(20)
+        advance_steps(sim, 20)
         out.append(sim.monitors()["laser_energy_J_per_m"])
     assert out[1] / out[0] == pytest.approx(RHO, rel=1e-9)
 
@@ -249,9 +249,9 @@ def _heat_cool(T_wall: float, hysteresis: bool = True, cool_s: float = 4e-3):
     sim = Simulation(_cooling_block(T_wall, hysteresis))
     assert sim.state.cfg.hysteresis == hysteresis
     H0 = sim.monitors()["enthalpy_J_per_m"]
-    sim.advance(int(round(2e-4 / sim.dt)))
+    advance_steps(sim, int(round(2e-4 / sim.dt)))
     molten = sim.state.points.solid_fraction.to_numpy() == 0.0
-    sim.advance(int(round(cool_s / sim.dt)))
+    advance_steps(sim, int(round(cool_s / sim.dt)))
     m = sim.monitors()
     pt = sim.state.points
     T, xi = pt.T.to_numpy() - KELVIN, pt.solid_fraction.to_numpy()
@@ -309,7 +309,7 @@ def test_unset_hysteresis_is_the_paper_model_bitwise():
         sim = Simulation(case)
         assert sim.state.cfg.hysteresis == bool(extra)
         assert sim.state.cfg.kinetics == ("KIN" in extra)
-        sim.advance(400)
+        advance_steps(sim, 400)
         pt = sim.state.points
         out.append([pt.T.to_numpy(), pt.solid_fraction.to_numpy(), pt.x.to_numpy()])
     assert out[0][1].min() == 0.0  # the pair melted

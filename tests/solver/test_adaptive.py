@@ -124,16 +124,17 @@ def test_a_redone_step_starts_from_the_state_before_it():
     checkpoint.capture) is everything a step reads: steps taken after a restore repeat the
     first ones bit for bit (serial layout)."""
     sim = Simulation(load_case("power25W_coarse", [*ADAPTIVE, "solver.layout=serial"]))
-    sim.advance(2)
+    sim.advance_to(2 * sim.dt)
     before, dt_next = checkpoint.capture(sim.state, points=False), sim.adaptive.dt
     kept = struct_type(POINT_MEMBERS, 2).field(shape=sim.state.n_points)
     copy_points(sim.state.points, kept, True)
-    sim.advance(3)
+    end = sim.t + 3 * sim.dt
+    sim.advance_to(end)
     first = sim.state.points.to_numpy()
     copy_points(sim.state.points, kept, False)
     checkpoint.restore(sim.state, before)
     sim.adaptive.dt = dt_next
-    sim.advance(3)
+    sim.advance_to(end)
     again = sim.state.points.to_numpy()
     for k in ("x", "v", "T", "stress", "enthalpy", "F"):
         assert np.array_equal(first[k], again[k]), k
@@ -146,7 +147,7 @@ def test_a_step_refused_by_newton_keeps_the_energy_balance_in_blocks(monkeypatch
     The balance stays at round-off (1e-12, against the guard's 1e-6) with the laser on."""
     sim = Simulation(load_case("power25W_coarse", [*ADAPTIVE, "solver.layout=blocks"]))
     sim.monitors()  # the initial enthalpy, the balance's reference
-    sim.advance(3)
+    sim.advance_to(3 * sim.dt)
     newton = ImplicitStepper.newton
     calls = {"n": 0}
 
@@ -157,7 +158,7 @@ def test_a_step_refused_by_newton_keeps_the_energy_balance_in_blocks(monkeypatch
         return newton(self, sys_)
 
     monkeypatch.setattr(ImplicitStepper, "newton", fail_once)
-    sim.advance(2)
+    sim.advance_to(sim.t + 2 * sim.dt)
     assert sim.adaptive.refused >= 1 and calls["n"] >= 3
     mon = sim.monitors()
     assert mon["laser_energy_J_per_m"] > 0.0
@@ -171,7 +172,7 @@ def test_an_adaptive_run_resumes_on_the_frame_times_it_started_with(tmp_path):
     case = load_case("power25W_coarse", ADAPTIVE)
     sim = Simulation(case)
     first = sim.dt
-    sim.advance(4)
+    sim.advance_to(4.5 * first)  # the last step, cut to land there, is not the first's
     assert sim.adaptive.last_dt != first
     sim.save_checkpoint(tmp_path / "checkpoint.npz")
     t, next_dt = sim.t, sim.adaptive.dt  # read before a new Simulation starts Taichi afresh
@@ -188,7 +189,7 @@ def test_a_step_below_dt_min_ends_with_a_clear_error():
     sets.append("time.dt_min_s=1e-6")
     sim = Simulation(load_case("power25W_coarse", sets))
     with pytest.raises(SimulationError, match="time.dt_min_s"):
-        sim.advance(5)
+        sim.advance_to(5 * sim.dt)
     assert sim.adaptive.refused >= 1
 
 

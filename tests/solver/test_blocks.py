@@ -3,7 +3,7 @@ same at any thread count, and points sorted again when they drift out of their b
 
 import numpy as np
 import pytest
-from helpers import PAPER_SCENE, deep_update, make_case
+from helpers import PAPER_SCENE, advance_steps, deep_update, make_case
 
 from taichi_sls.solver.simulation import Simulation
 
@@ -14,11 +14,11 @@ def _run(
     data = deep_update(PAPER_SCENE, {"grid": {"spacing_um": 4.0}, "lasers": [{"power_W": 25.0}]})
     data = deep_update(data, {"solver": {"layout": layout, "threads": threads}, **(extra or {})})
     sim = Simulation(make_case(data))
-    sim.advance(steps // 2)
+    advance_steps(sim, steps // 2)
     if shift:  # every point carried along x by ``shift`` metres, as if it had flowed there
         pt = sim.state.points
         pt.x.from_numpy(pt.x.to_numpy() + [shift, 0.0])
-    sim.advance(steps - steps // 2)
+    advance_steps(sim, steps - steps // 2)
     pt = sim.state.points
     order = np.lexsort(pt.x0.to_numpy().T)  # the blocks layout sorts the points
     out = {k: getattr(pt, k).to_numpy()[order] for k in ("x", "v", "T", "stress")}
@@ -79,14 +79,14 @@ def test_a_run_resumed_after_a_sort_continues_bitwise(tmp_path):
     )
     case = make_case(data)
     sim = Simulation(case)
-    sim.advance(30)
+    advance_steps(sim, 30)
     pt = sim.state.points
     pt.x.from_numpy(pt.x.to_numpy() + [20e-6, 0.0])  # flowed 5 cells: sorted at the next step
-    sim.advance(1)
+    advance_steps(sim, 1)
     assert sim.blocks.sorts > 0
     path = tmp_path / "checkpoint.npz"
     sim.save_checkpoint(path)
-    sim.advance(30)
+    advance_steps(sim, 30)
     keys = ("x", "v", "T", "stress", "mass", "volume0")
     want = {k: getattr(sim.state.points, k).to_numpy() for k in keys}
     want["body_id"] = sim.snapshot(full=True)["body_id"]
@@ -94,7 +94,7 @@ def test_a_run_resumed_after_a_sort_continues_bitwise(tmp_path):
 
     again = Simulation(case)
     again.load_checkpoint(path)
-    again.advance(30)
+    advance_steps(again, 30)
     for k in keys:
         assert np.array_equal(getattr(again.state.points, k).to_numpy(), want[k]), k
     assert np.array_equal(again.snapshot(full=True)["body_id"], want["body_id"])

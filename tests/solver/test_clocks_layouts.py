@@ -3,7 +3,7 @@ must not change what the model computes beyond its stated error."""
 
 import numpy as np
 import pytest
-from helpers import PAPER_SCENE, deep_update, make_case
+from helpers import PAPER_SCENE, advance_steps, deep_update, make_case
 
 from taichi_sls.config import CaseError
 from taichi_sls.solver.simulation import Simulation
@@ -63,7 +63,7 @@ def test_laser_energy_is_exact_across_heat_steps():
         sim = Simulation(make_case(_heat_only(n)))
         assert sim.heat_every == n
         H0 = sim.monitors()["enthalpy_J_per_m"]
-        sim.advance(140)  # 7e-6 s, past the pulse end at 3.33e-6 s
+        advance_steps(sim, 140)  # 7e-6 s, past the pulse end at 3.33e-6 s
         m = sim.monitors()
         out[n] = m["laser_energy_J_per_m"]
         assert abs(m["enthalpy_J_per_m"] - H0 - out[n]) < 1e-9 * out[n]
@@ -79,7 +79,7 @@ def test_heat_clock_error_is_first_order():
     T = {}
     for n in (1, 9, 19):
         sim = Simulation(make_case(_heat_only(n, off_s=2e-5)))
-        sim.advance(9 * 19 * 4)
+        advance_steps(sim, 9 * 19 * 4)
         T[n] = sim.state.points.T.to_numpy()
     rise = T[1].max() - (140.0 + 273.15)
     err = {n: np.abs(T[n] - T[1]).max() for n in (9, 19)}
@@ -98,7 +98,7 @@ def test_parallel_layout_matches_the_serial_one():
         data["lasers"] = [{"power_W": 25.0}]
         sim = Simulation(make_case(data))
         assert sim.state.cfg.parallel == (layout == "parallel")
-        sim.advance(60)
+        advance_steps(sim, 60)
         res.append(
             (
                 sim.state.points.x.to_numpy(),
@@ -125,7 +125,7 @@ def test_active_region_is_exact_and_skips_the_empty_grid():
         )
         data["lasers"] = [{"power_W": 25.0}]
         sim = Simulation(make_case(data))
-        sim.advance(100)
+        advance_steps(sim, 100)
         box = sim.state.box[None]
         res.append((sim.state.points.x.to_numpy(), sim.state.points.T.to_numpy(), sim.monitors()))
         if active:  # the pair is 10 cells tall; the region stops 17 nodes above it, of 55

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import make_case
+from helpers import advance_steps, make_case
 
 from taichi_sls.config import Material
 from taichi_sls.solver.params import stability_limits
@@ -81,7 +81,7 @@ def test_insulated_box_conserves_heat():
     sim = Simulation(make_case(_box3(16.0, bodies, physics=HEAT_ONLY, boundary=INSULATED)))
     assert sim.scene.n_points == 8**3 * 8
     m0 = sim.monitors()
-    sim.advance(200)
+    advance_steps(sim, 200)
     m = sim.monitors()
     assert abs(m["enthalpy_J_per_m"] / m0["enthalpy_J_per_m"] - 1.0) < 1e-12
     assert m["heat_out_J_per_m"] == 0.0
@@ -104,7 +104,7 @@ def _slab(dim: int, subgrid_filter: float) -> np.ndarray:
         data["domain"]["depth_um"] = 8.0
         data["bodies"][0].update(min_um=[0, 0, 0], max_um=[8, 16, 8])
     sim = Simulation(make_case(data))
-    sim.advance(100)
+    advance_steps(sim, 100)
     return sim.state.points.T.to_numpy()
 
 
@@ -147,7 +147,7 @@ def test_free_sphere_keeps_mass_and_momentum():
     assert sim.scene.n_points == 912
     M0, P0, X0 = _momentum(sim)
     np.testing.assert_allclose(P0, M0 * v0, rtol=1e-14)
-    sim.advance(300)
+    advance_steps(sim, 300)
     M, P, X = _momentum(sim)
     assert M == M0
     assert np.abs(P - P0).max() < 1e-9 * np.abs(P0).max()
@@ -163,7 +163,7 @@ def test_slip_wall_in_z_stops_the_sphere_and_keeps_its_slide():
     momentum goes or turns, and its x momentum, along the wall, is kept."""
     sim = _sphere([0.1, 0.0, 1.0], 17.0)  # 1 um from the wall, 12 um of travel in 300 steps
     M0, P0, _ = _momentum(sim)
-    sim.advance(300)
+    advance_steps(sim, 300)
     _, P, _ = _momentum(sim)
     z = sim.state.points.x.to_numpy()[:, 2]
     assert z.max() < 24e-6

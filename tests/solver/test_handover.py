@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import advance_steps
 
 from taichi_sls.config import CaseError, load_case
 from taichi_sls.jobs.case_run import run_case
@@ -33,7 +34,7 @@ def test_the_explicit_phase_is_the_explicit_integrator_bit_for_bit():
 def explicit_1ms():
     """The coarse 25 W pair's explicit run to 1 ms: its monitors and steps."""
     explicit = Simulation(load_case("power25W_coarse"))
-    explicit.advance(round(1e-3 / explicit.dt))
+    advance_steps(explicit, round(1e-3 / explicit.dt))
     return explicit.monitors(), explicit.steps
 
 
@@ -67,8 +68,8 @@ def test_explicit_steps_take_back_a_step_too_short_for_the_implicit_one(explicit
     sim = Simulation(load_case("power25W_coarse", [*HYBRID, "time.handback_explicit_steps=60"]))
     sim.advance_to(sim.handover.lasers_off_s)
     while sim.explicit_now:
-        sim.advance(1)
-    sim.advance(1)  # the first implicit step would be 50 explicit ones: handed back instead
+        advance_steps(sim, 1)
+    advance_steps(sim, 1)  # the first implicit step would be 50 explicit ones: handed back instead
     assert sim.explicit_now and sim.handover.handbacks == 1
     assert (sim.state.scalars.step[None] - 1) % sim.explicit_state.cfg.heat_every == 0
     assert sim.state.scalars.dt[None] == sim.dt

@@ -4,7 +4,7 @@ solves, its verification rows at steps far beyond the explicit limits, and its i
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from helpers import deep_update, explicit_coarse_peak_C, shared
+from helpers import advance_steps, deep_update, explicit_coarse_peak_C, shared
 
 from taichi_sls.config import CaseError, load_case
 from taichi_sls.solver import checkpoint
@@ -38,7 +38,7 @@ def _step_disc():
         return checkpoint.capture(st), st.scalars.to_numpy(), st.box.to_numpy(), sim.steps
 
     at_rest = saved()
-    sim.advance(1)
+    advance_steps(sim, 1)
     return sim, {0: at_rest, 1: saved()}
 
 
@@ -57,7 +57,7 @@ def _stepped_disc(steps: int = 1) -> Simulation:
     sim.steps = done
     sim.implicit.penalty = sim.case.time.implicit_velocity_penalty
     if steps > start:
-        sim.advance(steps - start)
+        advance_steps(sim, steps - start)
     return sim
 
 
@@ -255,7 +255,7 @@ def test_a_singular_newton_matrix_refuses_the_step(monkeypatch):
 
     monkeypatch.setattr(ImplicitStepper, "internal", singular_tangent)
     with pytest.raises(NewtonError, match=r"implicit step 1 .*linear solve failed"):
-        sim.advance(1)
+        advance_steps(sim, 1)
 
 
 @pytest.mark.slow
@@ -328,7 +328,7 @@ def test_implicit_heat_keeps_the_energy_balance():
     sim = Simulation(load_case("power25W_coarse", sets))
     assert sim.heat_substeps > 1
     for _ in range(20):
-        sim.advance(1)
+        advance_steps(sim, 1)
         mon = sim.monitors()
         assert abs(sim.energy_error(mon)) < 1e-12
     assert mon["laser_energy_J_per_m"] > 0

@@ -75,7 +75,7 @@ def test_the_filtered_colour_widens_a_concave_neck_by_less_than_kappa_h2(name, e
     sets = ("solver.optimize=false", "contact.neck_section=centres", "contact.neck_colour=raw")
     sim = Simulation(taichi_sls.load_case(name, [*sets, *extra]))
     assert sim.state.cfg.h == pytest.approx(h * 1e-6)
-    raw = sim.necks_m()[0] * 1e6
+    raw = sim.necks.necks_m()[0] * 1e6
     sim.case.contact.neck_colour = "filtered"
-    filtered = sim.necks_m()[0] * 1e6
+    filtered = sim.necks.necks_m()[0] * 1e6
     assert 0.0 < filtered - raw < h * h / rho

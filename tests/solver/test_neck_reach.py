@@ -87,11 +87,11 @@ def test_a_neck_below_the_initial_diameter_reads_as_before(name, sets):
     whole steps from the line of centres, so the longer reach adds samples, moving none). The
     paper's cases read the column and do not call necks_m."""
     sim = Simulation(load_case(name, ["solver.optimize=false", *sets]))
-    field = sim._material_field(sim.neck_measure(), "centres")
-    centre, (ra, rb), cfg = sim.body_centres_m(), sim.body_radii_m[:2], sim.state.cfg
+    field = sim.necks.material_field(sim.necks.neck_measure(), "centres")
+    centre, (ra, rb), cfg = sim.necks.body_centres_m(), sim.necks.body_radii_m[:2], sim.state.cfg
     old, _ = neck_section(field, cfg.h, cfg.off, centre[0], centre[1], min(ra, rb))
     assert 0.0 < old < 2.0 * min(ra, rb)
-    assert sim.necks_m()[0] == pytest.approx(old, rel=1e-12)
+    assert sim.necks.necks_m()[0] == pytest.approx(old, rel=1e-12)
     assert sim.monitors()["contact_line_um"] == pytest.approx(old * 1e6, rel=1e-12)
 
 
@@ -104,9 +104,9 @@ def test_the_sections_read_the_colour_the_case_names(colour):
     sim = Simulation(
         load_case("nolaser", ["solver.optimize=false", f"contact.neck_colour={colour}"])
     )
-    field = sim._material_field("colour", "centres") + 0.5
-    want = sim.colour() if colour == "filtered" else sim.raw_colour()
+    field = sim.necks.material_field("colour", "centres") + 0.5
+    want = sim.necks.colour() if colour == "filtered" else sim.necks.raw_colour()
     assert np.abs(field - want).max() < 1e-12
-    assert sim.pair_necks_m()[0] == pytest.approx(sim.necks_m("colour")[0], rel=1e-9)
+    assert sim.necks.pair_necks_m()[0] == pytest.approx(sim.necks.necks_m("colour")[0], rel=1e-9)
     expected = {"filtered": 13.58, "raw": 9.33}[colour]
-    assert sim.necks_m("colour")[0] * 1e6 == pytest.approx(expected, abs=0.05)
+    assert sim.necks.necks_m("colour")[0] * 1e6 == pytest.approx(expected, abs=0.05)

@@ -5,7 +5,7 @@ import tomllib
 
 import numpy as np
 import pytest
-from helpers import make_case
+from helpers import advance_steps, make_case
 
 from taichi_sls.config import CaseError, bundled_case
 from taichi_sls.solver.scene import build_scene
@@ -49,7 +49,7 @@ def _run(z_ranges, steps: int = 300):
     pt = sim.state.points
     m = pt.mass.to_numpy()
     p0 = (m[:, None] * pt.v.to_numpy()).sum(axis=0)
-    sim.advance(steps)
+    advance_steps(sim, steps)
     x, v = pt.x.to_numpy(), pt.v.to_numpy()
     return x, v, p0, (m[:, None] * v).sum(axis=0)
 
@@ -188,7 +188,7 @@ def _heat_run(hot, cold):
     sim = Simulation(make_case(d))
     pt = sim.state.points
     H0 = (pt.enthalpy.to_numpy() * pt.mass.to_numpy()).sum()
-    sim.advance(400)
+    advance_steps(sim, 400)
     H1 = (pt.enthalpy.to_numpy() * pt.mass.to_numpy()).sum()
     return pt.x.to_numpy(), pt.T.to_numpy(), H0, H1
 

@@ -70,9 +70,9 @@ def midplane_section(sim, case: Case) -> float:
         from ...solver.periodic_views import periodic_colour
 
         periodic_colour(sim.state)
-        c = sim.node_arrays()["colour"]
+        c = sim.necks.node_arrays()["colour"]
     else:
-        c = sim.colour()
+        c = sim.necks.colour()
     layers = [c] if c.ndim == 2 else [c[:, :, cfg.off + k] for k in range(cfg.ncz)]
     if turn == 0.0:
         return float(np.mean([colour_section(cl, cfg.h, cfg.off, centre[0]) for cl in layers]))
@@ -127,7 +127,7 @@ def colour_section(c: np.ndarray, h: float, off: int, x: float) -> float:
 def hopper_neck_history(vc: VerificationCase, tau_end: float, d_tau: float = 0.02) -> tuple:
     """Run a Hopper case; returns (sim, tau, r_n / R0, point area, viscous time, r_n / R0 of the
     per-contact section) sampled every d_tau until the aligned clock reaches tau_end. The
-    clock is aligned on the mid-plane's r_n; the last is half of ``Simulation.necks_m`` on the
+    clock is aligned on the mid-plane's r_n; the last is half of ``Necks.necks_m`` on the
     colour (the section across the centres the process results rest on), read beside it."""
     case, v = vc.case, vc.spec
     m = material(case)
@@ -141,7 +141,7 @@ def hopper_neck_history(vc: VerificationCase, tau_end: float, d_tau: float = 0.0
     def sample() -> None:
         ts.append(sim.t)
         rn.append(0.5 * midplane_section(sim, case) / R0)
-        necks = sim.necks_m("colour") if case.domain.dim == 2 else []
+        necks = sim.necks.necks_m("colour") if case.domain.dim == 2 else []
         rc.append(0.5 * necks[0] / R0 if necks else math.nan)  # one outline body: no contact
         area.append(float((st.points.volume0.to_numpy() * st.points.J.to_numpy()).sum()))
 
@@ -168,7 +168,7 @@ def hopper_neck_history(vc: VerificationCase, tau_end: float, d_tau: float = 0.0
 def run_hopper(vc: VerificationCase) -> Result:
     """Hopper's coalescence: r_n / R0 on the colour interface against the exact neck at each of
     ``hopper_taus`` (relative errors ``neck_tau<tau>`` on the mid-plane, ``neck_centres_tau<tau>``
-    on the per-contact section of ``Simulation.necks_m``) and the largest relative change of the
+    on the per-contact section of ``Necks.necks_m``) and the largest relative change of the
     points' area over the run."""
     t0 = time.perf_counter()
     taus = sorted(vc.spec.hopper_taus)
