@@ -48,6 +48,7 @@ from .bed_layer import melt_extent, relative_density, relative_density_3d
 from .outcome import laser_acted
 
 NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
+ARRAYS = ("initial", "melt", "melt_s", "final", "molten_now")  # ContactHistory's, per contact
 
 
 def is_bed(case: Case) -> bool:
@@ -116,16 +117,16 @@ class ContactHistory:
         self.melt_s = np.where(self.molten_now, sim.t, self.melt_s)
         self.final = necks
 
-    def restore(self, rows: list[dict[str, float]], density: dict | None) -> None:
-        """Continue a resumed run from its contacts table and summary (the frames before the
-        checkpoint are not stepped again)."""
-        if len(rows) != len(self.contacts):
-            return
-        self.initial = np.array([r["neck_initial_um"] for r in rows])
-        self.melt = np.array([r["neck_melt_um"] for r in rows])
-        self.melt_s = np.array([r["melt_end_s"] for r in rows])
-        self.density_initial = density
-        self.started = True
+    def state(self) -> dict[str, Any]:
+        """What a checkpoint keeps (JSON lists; NaN as NaN)."""
+        arrays = {k: getattr(self, k).tolist() for k in ARRAYS}
+        return {**arrays, "density_initial": self.density_initial, "started": self.started}
+
+    def restore_state(self, state: dict[str, Any]) -> None:
+        """Continue a resumed run from :meth:`state` of its checkpoint."""
+        for k in ARRAYS:
+            setattr(self, k, np.array(state[k], dtype=bool if k == "molten_now" else float))
+        self.density_initial, self.started = state["density_initial"], state["started"]
 
     def rows(self, sim: Simulation) -> list[dict[str, float]]:
         """The contacts table (contacts.csv), one row per contact, with the verdict."""

@@ -12,7 +12,6 @@ import math
 from collections.abc import Iterator, Sequence
 
 from ..config import Case
-from ..solver.simulation import Simulation
 from .outcome import laser_acted
 
 DEFAULT_LINEAR_FRAMES = 20  # linear spacing when output.frames is not set
@@ -54,20 +53,10 @@ def frame_steps(case: Case, dt: float) -> Iterator[int]:
         k += 1
 
 
-def reached(sim: Simulation, frame_step: int) -> bool:
-    """Whether the run has reached a frame's step (its time, with the adaptive step)."""
-    if sim.adaptive is None:
-        return sim.steps >= frame_step
-    return sim.t >= frame_step * sim.dt * (1.0 - 1e-12)
-
-
-def step_towards(sim: Simulation, frame_step: int, chunk: int = 2000) -> None:
-    """Steps towards a frame: fixed ones, at most ``chunk`` (a progress bar updates between),
-    or adaptive ones that land on its time."""
-    if sim.adaptive is not None:
-        sim.advance_to(frame_step * sim.dt)
-    else:
-        sim.advance(min(chunk, frame_step - sim.steps))
+def frame_times(case: Case, dt: float) -> list[float]:
+    """The time of each frame after the first (s): the steps of :func:`frame_steps` times the
+    run's first dt (an adaptive run lands on these times; a fixed one takes these steps)."""
+    return [step * dt for step in frame_steps(case, dt)]
 
 
 SETTLED_FRAMES = 3  # frames before the last that an unheated case's neck must agree with
