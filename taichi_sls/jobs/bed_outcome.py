@@ -214,12 +214,15 @@ BED_SERIES = (
 )
 
 
-def bed_monitors(sim: Simulation, rows: list[dict[str, float]]) -> dict[str, float]:
+def bed_monitors(
+    sim: Simulation, rows: list[dict[str, float]], density: dict[str, float] | None = None
+) -> dict[str, float]:
     """The bed's quantities at this output frame, from the measures of its outcome: the layer's
     relative density and mean top (layer_density), the median of the contacts' necks now, and
     how many contacts have melted through, hold melt now and are fused by the verdict's rule
-    as it reads at this frame (a contact counts as fused once it has refrozen)."""
-    d = layer_density(sim)
+    as it reads at this frame (a contact counts as fused once it has refrozen). ``density``:
+    the layer's now, when already read."""
+    d = density or layer_density(sim)
     n = len(rows)
     fused = sum(int(r["fused"]) for r in rows)
     necks = np.array([r["neck_final_um"] for r in rows], dtype=float)
@@ -244,14 +247,18 @@ def _quartiles(v: np.ndarray) -> dict[str, float]:
 
 
 def bed_summary(
-    sim: Simulation, rows: list[dict[str, float]], density_initial: dict | None
+    sim: Simulation,
+    rows: list[dict[str, float]],
+    density_initial: dict | None,
+    density_final: dict | None = None,
 ) -> dict[str, Any]:
     """The summary's ``bed`` record: contacts, fused share, neck statistics, the layer's
     relative density before and after (with the generator's packing fractions) and the melt
-    track (lengths in um)."""
+    track (lengths in um). ``density_final``: the layer's at the end, when already read (an
+    interrupted run's last frame)."""
     n = len(rows)
     col = {k: np.array([r[k] for r in rows], dtype=float) for k in (*NECKS, "fused")}
-    after = layer_density(sim)
+    after = density_final or layer_density(sim)
     pt = sim.point_arrays(("x0", "time_molten"))
     spacing = sim.state.cfg.h / sim.case.grid.points_per_cell
     top = sim.case.top_um() * 1e-6

@@ -22,7 +22,7 @@ from typing import Any
 from ..solver.simulation import Simulation
 
 CHUNK_WALL_S = 0.25  # the wall time one chunk of fixed steps aims at
-FIRST_CHUNK = 8  # steps of the first chunk, before the pace is known
+FIRST_CHUNK = 1  # steps of the first chunk, before the pace is known
 CHUNK_GROWTH = 4  # a chunk at most this many times the last one
 
 

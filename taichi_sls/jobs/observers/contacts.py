@@ -11,7 +11,7 @@ from ...io.bed_outcome_plot import plot_bed_outcome
 from ...io.contacts_plot import plot_contacts
 from ...io.contacts_table import write_contacts
 from ...solver.simulation import Simulation
-from ..bed_outcome import ContactHistory, bed_monitors, bed_summary
+from ..bed_outcome import ContactHistory, bed_monitors, bed_summary, layer_density
 from ..run_loop import Frame, Observer, RunEnd
 
 CONTACTS = "contacts.csv"
@@ -26,12 +26,14 @@ class Contacts(Observer):
         self.history = ContactHistory(sim)
         self.out_dir = out_dir
         self.rows: list[dict[str, float]] = []
+        self.density: dict[str, float] | None = None  # the layer's at the last frame
 
     def frame(self, frame: Frame) -> None:
         self.history.add(frame.sim)
         self.rows = self.history.rows(frame.sim)
         write_contacts(self.out_dir / CONTACTS, self.rows)
-        frame.monitors.update(bed_monitors(frame.sim, self.rows))  # the bed's series
+        self.density = layer_density(frame.sim)
+        frame.monitors.update(bed_monitors(frame.sim, self.rows, self.density))  # its series
 
     def finish(self, end: RunEnd) -> None:
         sim, case = end.sim, end.sim.case
@@ -42,11 +44,13 @@ class Contacts(Observer):
         }
         if case.domain.dim == 3:  # the 3D generator's own report
             end.summary["bed_generator"] = case.bed_report()
-        try:
-            if not end.interrupted:  # else the last frame's table stands
+        try:  # an interrupted run keeps its last frame's table and density: no new reading
+            final = self.density if end.interrupted else None
+            if not end.interrupted:
                 self.rows = self.history.rows(sim)
                 write_contacts(self.out_dir / CONTACTS, self.rows)
-            end.summary["bed"] = bed_summary(sim, self.rows, self.history.density_initial)
+            initial = self.history.density_initial
+            end.summary["bed"] = bed_summary(sim, self.rows, initial, final)
             if not end.interrupted:
                 self._plots(sim, end.summary["bed"]["relative_density"])
         except Exception as e:  # noqa: BLE001 -- never cost the run's other outputs
@@ -70,9 +74,9 @@ class Contacts(Observer):
         )
 
     def state(self) -> dict[str, Any]:
-        return {**self.history.state(), "rows": self.rows}
+        return {**self.history.state(), "rows": self.rows, "density": self.density}
 
     def restore(self, state: dict[str, Any]) -> None:
         if state:
             self.history.restore_state(state)
-            self.rows = state["rows"]
+            self.rows, self.density = state["rows"], state["density"]

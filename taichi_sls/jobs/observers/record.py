@@ -46,8 +46,9 @@ class Record(Observer):
         sim, s = end.sim, end.summary
         if self.settle is not None:
             s["settle"] = self.settle
-        s["initial"] = self.initial
-        s.update(steps=sim.steps, simulated_s=sim.t, final=self.last)
+        if self.initial is not None:  # else stopped before its first frame
+            s.update(initial=self.initial, final=self.last)
+        s.update(steps=sim.steps, simulated_s=sim.t)
         s.update(self.counts(sim))
         s.update(
             handover_s=sim.handover.at_s if sim.handover is not None else None,

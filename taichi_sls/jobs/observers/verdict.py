@@ -31,6 +31,8 @@ class PairVerdict(Observer):
         self.last = frame.monitors
 
     def finish(self, end: RunEnd) -> None:
+        if not self.last:  # stopped before its first frame: nothing to judge
+            return
         sim = end.sim
         arrays = sim.point_arrays()
         in_neck = neck_region(self.case, arrays["x0"], sim.scene.body, arrays["mass"])
