@@ -1,15 +1,17 @@
 """The main job: run one case to its end (``time.stop``), writing every output.
 
-Writes to the output folder (default ``out/<case name>/``): ``frames/*.png``, ``animation.gif``,
-``timeseries.csv`` (one row per output frame), ``timeseries.png``, ``outcome.png``,
-``summary.json`` (with the fusion ``outcome``), the resolved ``case.toml`` and, with
-``output.vtu = true``, ParaView point data. A case of more than two bodies (a bed) adds
-``contacts.csv`` and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py),
-the bed's own columns of the time series and plots (the layer's density, melt and contacts
-over time: io/series.BED_PANELS; the contacts map and necks: io/bed_outcome_plot.py),
-its verdict per contact, and ``layer.npz``, its points at the end (``bed.previous_layer`` of a
-next layer). Every file is written atomically; an interrupted or
-failed run still leaves valid files and a summary that says so.
+A short pipeline: build the simulation, settle or resume, then the run loop
+(jobs/run_loop.py: ``advance_to`` each frame time, hand the frame to each observer), then each
+observer's ``finish``. The observers (jobs/observers/) write the output folder (default
+``out/<case name>/``): ``frames/*.png``, ``animation.gif``, ``timeseries.csv`` (one row per
+output frame), ``timeseries.png``, ``outcome.png``, ``summary.json`` (with the pair's fusion
+``outcome``), the resolved ``case.toml`` and, with ``output.vtu = true``, ParaView point data.
+A case of more than two bodies (a bed) has its verdict per contact instead: ``contacts.csv``
+and ``contacts.png``, the summary's ``bed`` record (jobs/bed_outcome.py), the bed's own columns
+of the time series and plots (io/series.BED_PANELS, io/bed_outcome_plot.py), and
+``layer.npz``, its points at the end (``bed.previous_layer`` of a next layer). Every file is
+written atomically; an interrupted or failed run still leaves valid files and a summary that
+says so. An interrupted run draws nothing more (no GIF, plots or layer file).
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ class Checkpoints(Observer):
         self.path, self.every, self.observers = path, every, observers
 
     def frame(self, frame: Frame) -> None:
-        if self.every and frame.index % self.every == 0:
+        if self.every and frame.index > 0 and frame.index % self.every == 0:
             save(frame.sim, self.path, frame.index, self.observers)
 
 
