@@ -106,6 +106,9 @@ def run_command(args: argparse.Namespace) -> int:
     except CaseError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # before the run's loop: its unheated baseline, its compile
+        print("interrupted before the run began (no summary)", file=sys.stderr)
+        return EXIT_CODES["interrupted"]
     if "final" not in summary:  # failed before the first frame (settling, say)
         print(f"error: {summary.get('error', summary['status'])}", file=sys.stderr)
         return EXIT_CODES[summary["status"]]

@@ -58,6 +58,9 @@ class SeriesWriter:
             if k not in self.header:
                 self.header.append(k)
         self._lines.append([fmt_cell(values.get(k)) for k in self.header])
+        self._write()
+
+    def _write(self) -> None:
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(self.header)
@@ -78,6 +81,16 @@ class SeriesWriter:
                     row[k] = float("nan")
             out.append(row)
         return out
+
+    def saved(self) -> dict[str, list]:
+        """The header and rows so far (as written), for a checkpoint."""
+        return {"header": list(self.header), "lines": [list(c) for c in self._lines]}
+
+    def restore(self, saved: dict[str, list]) -> None:
+        """Continue from :meth:`saved`: the rows up to a checkpoint, the file rewritten so."""
+        self.header = list(saved["header"])
+        self._lines = [list(c) for c in saved["lines"]]
+        self._write()
 
     def resume(self) -> None:
         """Keep the rows an earlier run wrote."""

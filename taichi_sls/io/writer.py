@@ -27,11 +27,6 @@ VTU_DEFORM_NAMES = {
 }
 
 
-def per_metre_to_joules(column: str) -> str:
-    """A 2D energy column (``..._J_per_m``, per metre of depth) named for 3D (``..._J``)."""
-    return column.removesuffix("_J_per_m") + "_J" if column.endswith("_J_per_m") else column
-
-
 class OutputWriter:
     """Writes everything a run produces into ``out_dir``; see the module docstring."""
 
@@ -88,10 +83,8 @@ class OutputWriter:
         write_summary(self.out_dir / "summary.json", data)
 
     def row(self, values: dict[str, float]) -> None:
-        """Append a row to timeseries.csv (the whole file rewritten atomically). In 3D the
-        energies are in J, not per metre of depth: their columns end in ``_J`` there."""
-        if self.view3d is not None:
-            values = {per_metre_to_joules(k): v for k, v in values.items()}
+        """Append a row to timeseries.csv (the whole file rewritten atomically); the keys name
+        their units (a 3D run's energies end in ``_J``: jobs/run_loop.named_monitors)."""
         self.series.row(values)
 
     @property
@@ -102,6 +95,10 @@ class OutputWriter:
     def resume(self) -> None:
         """Continue an existing output folder: keep its time series rows and frames."""
         self.series.resume()
+        self.resume_frames()
+
+    def resume_frames(self) -> None:
+        """Continue an existing output folder's frames (PNG for the GIF, VTU collections)."""
         self._vtu.resume()
         for p in sorted((self.out_dir / "frames").glob("frame_*.png")):
             self._png_paths[int(p.stem.split("_")[1])] = p
@@ -188,13 +185,21 @@ class OutputWriter:
     def finish(self, events: dict[str, float] | None = None) -> None:
         """Write animation.gif (if enabled) and timeseries.png (``events``, label: time in s,
         marked on a bed's); release the figure."""
+        self.finish_frames()
+        self.plot_series(events)
+
+    def finish_frames(self, gif: bool = True) -> None:
+        """Release the figure; write animation.gif if enabled and ``gif``."""
         self._painter.close()
-        if self.gif:
+        if self.gif and gif:
             paths = [p for _, p in sorted(self._png_paths.items())]
             if not paths:  # e.g. a fresh writer finishing an earlier run's folder
                 paths = sorted((self.out_dir / "frames").glob("frame_*.png"))
             if paths:
                 write_gif(paths, self.out_dir / "animation.gif")
+
+    def plot_series(self, events: dict[str, float] | None = None) -> None:
+        """timeseries.png (``events``, label: time in s, marked on a bed's)."""
         csv_path, png_path = self.out_dir / "timeseries.csv", self.out_dir / "timeseries.png"
         if self.bed:
             plot_series(csv_path, png_path, BED_PANELS, BED_PANELS_PER_ROW, events, True)

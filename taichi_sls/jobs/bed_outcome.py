@@ -48,6 +48,7 @@ from .bed_layer import layer_density, melt_extent
 from .outcome import laser_acted
 
 NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
+ARRAYS = ("initial", "melt", "melt_s", "final", "molten_now")  # ContactHistory's, per contact
 
 
 def is_bed(case: Case) -> bool:
@@ -116,16 +117,16 @@ class ContactHistory:
         self.melt_s = np.where(self.molten_now, sim.t, self.melt_s)
         self.final = necks
 
-    def restore(self, rows: list[dict[str, float]], density: dict | None) -> None:
-        """Continue a resumed run from its contacts table and summary (the frames before the
-        checkpoint are not stepped again)."""
-        if len(rows) != len(self.contacts):
-            return
-        self.initial = np.array([r["neck_initial_um"] for r in rows])
-        self.melt = np.array([r["neck_melt_um"] for r in rows])
-        self.melt_s = np.array([r["melt_end_s"] for r in rows])
-        self.density_initial = density
-        self.started = True
+    def state(self) -> dict[str, Any]:
+        """What a checkpoint keeps (JSON lists; NaN as NaN)."""
+        arrays = {k: getattr(self, k).tolist() for k in ARRAYS}
+        return {**arrays, "density_initial": self.density_initial, "started": self.started}
+
+    def restore_state(self, state: dict[str, Any]) -> None:
+        """Continue a resumed run from :meth:`state` of its checkpoint."""
+        for k in ARRAYS:
+            setattr(self, k, np.array(state[k], dtype=bool if k == "molten_now" else float))
+        self.density_initial, self.started = state["density_initial"], state["started"]
 
     def rows(self, sim: Simulation) -> list[dict[str, float]]:
         """The contacts table (contacts.csv), one row per contact, with the verdict."""
@@ -181,12 +182,15 @@ BED_SERIES = (
 )
 
 
-def bed_monitors(sim: Simulation, rows: list[dict[str, float]]) -> dict[str, float]:
+def bed_monitors(
+    sim: Simulation, rows: list[dict[str, float]], density: dict[str, float] | None = None
+) -> dict[str, float]:
     """The bed's quantities at this output frame, from the measures of its outcome: the layer's
     relative density and mean top (layer_density), the median of the contacts' necks now, and
     how many contacts have melted through, hold melt now and are fused by the verdict's rule
-    as it reads at this frame (a contact counts as fused once it has refrozen)."""
-    d = layer_density(sim)
+    as it reads at this frame (a contact counts as fused once it has refrozen). ``density``:
+    the layer's now, when already read."""
+    d = density or layer_density(sim)
     n = len(rows)
     fused = sum(int(r["fused"]) for r in rows)
     necks = np.array([r["neck_final_um"] for r in rows], dtype=float)
@@ -211,14 +215,18 @@ def _quartiles(v: np.ndarray) -> dict[str, float]:
 
 
 def bed_summary(
-    sim: Simulation, rows: list[dict[str, float]], density_initial: dict | None
+    sim: Simulation,
+    rows: list[dict[str, float]],
+    density_initial: dict | None,
+    density_final: dict | None = None,
 ) -> dict[str, Any]:
     """The summary's ``bed`` record: contacts, fused share, neck statistics, the layer's
     relative density before and after (with the generator's packing fractions) and the melt
-    track (lengths in um)."""
+    track (lengths in um). ``density_final``: the layer's at the end, when already read (an
+    interrupted run's last frame)."""
     n = len(rows)
     col = {k: np.array([r[k] for r in rows], dtype=float) for k in (*NECKS, "fused")}
-    after = layer_density(sim)
+    after = density_final or layer_density(sim)
     pt = sim.point_arrays(("x0", "time_molten"))
     spacing = sim.state.cfg.h / sim.case.grid.points_per_cell
     top = sim.case.top_um() * 1e-6

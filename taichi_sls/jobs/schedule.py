@@ -53,6 +53,12 @@ def frame_steps(case: Case, dt: float) -> Iterator[int]:
         k += 1
 
 
+def frame_times(case: Case, dt: float) -> list[float]:
+    """The time of each frame after the first (s): the steps of :func:`frame_steps` times the
+    run's first dt (an adaptive run lands on these times; a fixed one takes these steps)."""
+    return [step * dt for step in frame_steps(case, dt)]
+
+
 SETTLED_FRAMES = 3  # frames before the last that an unheated case's neck must agree with
 
 

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import sys
 import time
-from collections import deque
 
 import numpy as np
 
@@ -25,7 +24,9 @@ from ..solver import struct_copy
 from ..solver.guard import SimulationError
 from ..solver.params import laser_arrays
 from ..solver.simulation import Simulation
-from .schedule import SETTLED_FRAMES, frame_steps, settled
+from .observers.stop_rule import StopRule
+from .run_loop import Frame, Observer, Pacer, StopRequests, run_frames
+from .schedule import frame_times
 from .unheated import unheated_case
 
 
@@ -46,31 +47,40 @@ def lasers_absorb(sim: Simulation, absorb: bool) -> None:
     struct_copy.from_numpy(sim.state.lasers, beams)
 
 
-def settle(sim: Simulation, case: Case, progress: bool = True) -> dict[str, float]:
+class SettleLog(Observer):
+    """Prints each frame of the settling (with ``progress``)."""
+
+    def __init__(self, progress: bool) -> None:
+        self.progress = progress
+
+    def frame(self, frame: Frame) -> None:
+        m = frame.monitors
+        if self.progress and frame.index > 0:
+            print(
+                f"settling: t = {frame.sim.t * 1e3:.4g} ms, neck {m['contact_line_um']:.4g} um, "
+                f"kinetic energy {m['kinetic_ratio']:.2g} of the surface energy",
+                file=sys.stderr,
+            )
+
+
+def settle(
+    sim: Simulation, case: Case, progress: bool = True, stops: StopRequests | None = None
+) -> dict[str, float]:
     """Step ``sim`` unheated until its bodies have settled, then restart its clock at t = 0.
     Returns the record of the summary's ``settle``: the time it took (s), the steps, the first
     contact's neck (um) and the kinetic ratio at the end, the wall time (s). Raises
-    SimulationError if the bodies have not settled by ``time.max_s``."""
+    SimulationError if the bodies have not settled by ``time.max_s``. A run of the loop with
+    the settle rule's observers; ``stops``: the run's stop requests."""
     rule = settle_rule_case(case)
     wall0 = time.perf_counter()
     lasers_absorb(sim, False)
     if case.contact.settle_steps == "implicit" and sim.handover is not None:
         sim.handover.hand_over(sim.t)  # adaptive implicit steps from the start
-    last = sim.monitors()
-    before: deque[dict[str, float]] = deque(maxlen=SETTLED_FRAMES)
-    done = False
-    for frame_step in frame_steps(rule, sim.dt):
-        sim.advance_to(frame_step * sim.dt)
-        before.append(last)
-        last = sim.monitors()
-        if progress:
-            print(
-                f"settling: t = {sim.t * 1e3:.4g} ms, neck {last['contact_line_um']:.4g} um, "
-                f"kinetic energy {last['kinetic_ratio']:.2g} of the surface energy",
-                file=sys.stderr,
-            )
-        if done := settled(last, rule, sim.t, before):
-            break
+    stop = StopRule(rule)
+    times = [(0, sim.t), *enumerate(frame_times(rule, sim.dt), 1)]
+    pacer = Pacer(sim, stops or StopRequests())
+    done = run_frames(pacer, times, [stop, SettleLog(progress)])
+    last = stop.last
     if not done:
         raise SimulationError(
             f"contact.settle: the bodies had not settled by time.max_s = {case.time.max_s:g} s "

@@ -14,6 +14,8 @@ import math
 from ..config import Case
 from ..solver.guard import SimulationError
 from ..solver.simulation import Simulation
+from .observers.record import Record
+from .run_loop import Pacer, StopRequests, run_frames
 
 
 def unheated_case(case: Case) -> Case:
@@ -44,13 +46,16 @@ def needs_baseline(case: Case) -> bool:
 
 
 def unheated_neck_um(case: Case) -> float:
-    """The first contact's neck (um) at the end of the unheated run; NaN if it fails."""
+    """The first contact's neck (um) at the end of the unheated run; NaN if it fails. A run of
+    the loop with one frame, at ``fusion.baseline_s`` (fixed steps: the whole steps that reach
+    it)."""
     sim = Simulation(unheated_case(case))
+    end = case.fusion.baseline_s
+    if sim.adaptive is None:
+        end = math.ceil(end / sim.dt - 1e-9) * sim.dt
+    record = Record()
     try:
-        end = case.fusion.baseline_s  # adaptive or hybrid: steps of their own size, landing on it
-        if sim.adaptive is None:  # fixed steps: the whole ones that reach it
-            end = math.ceil(end / sim.dt - 1e-9) * sim.dt
-        sim.advance_to(end)
-        return sim.monitors()["contact_line_um"]
+        run_frames(Pacer(sim, StopRequests()), [(1, end)], [record])
     except SimulationError:  # the guard stopped it: the baseline is unknown
         return math.nan
+    return record.last["contact_line_um"]

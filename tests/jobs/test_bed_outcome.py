@@ -153,8 +153,8 @@ def test_the_time_series_holds_the_beds_quantities_at_every_frame(runs):
 
 def test_a_resumed_bed_run_keeps_its_contact_history(runs, tmp_path):
     """Stopped after the first of its three frames and resumed from the checkpoint, the run
-    ends with the contacts table and bed record of the uninterrupted run (the necks at the
-    start come back from contacts.csv, the density at the start from summary.json)."""
+    ends with the contacts table and bed record of the uninterrupted run (the necks and the
+    density at the start come back from the checkpoint)."""
     run_case(
         _bed_case(tmp_path, 0.85, 1e-5, 1), tmp_path / "out", progress=False, checkpoint_every=1
     )

@@ -10,7 +10,7 @@ import pytest
 from helpers import make_case
 
 from taichi_sls.config.layer_file import read_layer
-from taichi_sls.jobs.case_run import write_layer_file
+from taichi_sls.jobs.observers.layer_file import write_layer_file
 from taichi_sls.solver import struct_copy
 from taichi_sls.solver.simulation import Simulation
 
