@@ -1,7 +1,7 @@
 """The ``[bed]`` of a 3D case (``domain.dim = 3``): spheres deposited by random sequential
 deposition with rolling (deposition3d.py) between the domain's side walls, read from a CSV file
 of spheres, or both, turned into ``[[bodies]]`` spheres when the case is validated, as the 2D
-bed's discs are (bed.py; docs/beds.md, "3D beds")."""
+bed's discs are (bed.py; docs/record/beds.md, "3D beds")."""
 
 from __future__ import annotations
 

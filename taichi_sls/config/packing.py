@@ -1,4 +1,4 @@
-"""The packing fraction of a bed of discs, two ways (docs/beds.md).
+"""The packing fraction of a bed of discs, two ways (docs/record/beds.md).
 
 envelope: the discs' area over the area under the bed's top profile (at each x the highest disc
 top, 0 where no disc lies) between the side walls: the fraction of the layer as a laser sees it,

@@ -21,7 +21,7 @@ ROOT_CASES = Path(__file__).resolve().parents[2] / "cases"
 # Meakin's "restructuring" model (Europhys. Lett. 4, 1385, 1987) that follows the same rule;
 # random loose packing of spheres is about 0.55 and random close packing 0.64. The test holds
 # the bulk of a 2000-sphere periodic bed to 0.58 +- 0.015: its six seeds read 0.577-0.583
-# (docs/beds.md), and 0.015 is the sampling scatter of a core of ~1100 spheres (a few 0.001)
+# (docs/record/beds.md), and 0.015 is the sampling scatter of a core of ~1100 spheres (a few 0.001)
 # plus the spread of the published figures (0.58-0.59), well inside the 0.55-0.60 of the
 # issue and clear of both random loose and random close packing.
 DEPOSITION_3D = 0.58
