@@ -46,8 +46,8 @@ PAPER = [
         )
         for s in (1, 16, 256)
     ],
-    # the implicit integrator (docs/implicit.md): adaptive steps with backward-Euler heat, and
-    # explicit steps through the melting collapse handing over to them
+    # the implicit integrator (docs/record/implicit.md): adaptive steps with backward-Euler heat,
+    # and explicit steps through the melting collapse handing over to them
     *[
         (
             f"implicit, adaptive, strain {e:g}",

@@ -122,8 +122,9 @@ PAPER_RUNS = (
     ("power25W", "explicit", []),
     ("power25W", "implicit, adaptive", ADAPTIVE),
     ("power25W", "hybrid", ["time.integrator=hybrid"]),
-    # the reading that converges (docs/convergence.md): its own hybrid is the reference (halving
-    # its explicit step moves the neck by 0.06 %); the adaptive controls at twice their defaults
+    # the reading that converges (docs/record/convergence.md): its own hybrid is the reference
+    # (halving its explicit step moves the neck by 0.06 %); the adaptive controls at twice their
+    # defaults
     ("power25W_resolved", "hybrid", []),
     ("power25W_resolved", "implicit, adaptive", ADAPTIVE),
     (

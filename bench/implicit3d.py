@@ -10,7 +10,7 @@ with the rigid-body modes), the direct one also with the rows stored by blocks
 iterations, CG iterations per solve (0: the factorization alone), the unknowns, and the
 implicit grid fields' memory (the rows in the blocks they were written in, the rest over the
 grid) per grid node, per active node (one with unknowns) and per point.
-Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/implicit.md, "In
+Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/record/implicit.md, "In
 3D")."""
 
 import argparse

@@ -11,8 +11,8 @@ body touching every wall -- and classifies each row:
   beyond 1e-6, a temperature below the coldest start, wall or chamber, J outside (0, 20), a
   non-finite monitor. The goal is no such row.
 
-Writes ``robustness.csv`` and ``robustness.md`` (the table of docs/robustness.md) to the output
-folder.
+Writes ``robustness.csv`` and ``robustness.md`` (the table of docs/record/robustness.md) to the
+output folder.
 """
 
 from __future__ import annotations

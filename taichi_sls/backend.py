@@ -2,8 +2,9 @@
 
 Every module imports ``ti`` from here (``from taichi_sls.backend import ti``), so one environment
 variable, ``TAICHI_SLS_BACKEND``, swaps the compiler for the whole solver. The forks measured in
-docs/compile.md are drop-in for Taichi 1.7's public API (taichi-forge) or not (Quadrants renamed
-and removed names the solver uses); upstream ``taichi`` is the default (docs/compile.md says why).
+docs/record/compile.md are drop-in for Taichi 1.7's public API (taichi-forge) or not (Quadrants
+renamed and removed names the solver uses); upstream ``taichi`` is the default
+(docs/record/compile.md says why).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""A bed's CSV files (docs/beds.md): their columns read with one clear error per bad row, and a
+"""A bed's CSV files (docs/record/beds.md): their columns read with one clear error per bad row, and a
 CSV bed's particles checked (discs in 2D, spheres in 3D: the dimension is the domain's).
 
 A CSV bed is a previous layer as measured or exported: it is checked (rows, overlaps, support,

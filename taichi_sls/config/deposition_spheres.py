@@ -1,6 +1,6 @@
 """Random sequential deposition of spheres with rolling (Visscher & Bolsterli 1972; Jullien &
 Meakin 1987): the 3D algorithm behind config/deposition.py, the counterpart of
-deposition_discs.py (docs/beds.md, "3D beds").
+deposition_discs.py (docs/record/beds.md, "3D beds").
 
 Each sphere, in turn, falls vertically at a random (x, z) onto the plate (y = 0) or onto the
 spheres already there, then moves under gravity along the steepest descent its contacts allow:

@@ -1,5 +1,5 @@
 """A layer file (``layer.npz``): the material points of a finished bed run as they ended, which a
-later case reads as the previous layer to deposit on (``bed.previous_layer``, docs/beds.md).
+later case reads as the previous layer to deposit on (``bed.previous_layer``, docs/record/beds.md).
 
 Arrays (lengths in um): ``x_um`` (N, dim) positions, dim 2 or 3 (the run's ``domain.dim``);
 ``volume_um2`` (N,) current volumes in 2D (the seeded volume times J, per unit depth), or

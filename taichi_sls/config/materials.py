@@ -21,9 +21,9 @@ Poisson = Annotated[float, AfterValidator(_poisson)]
 class CrystallizationKinetics(Model):
     """Quiescent crystallisation kinetics (docs/model.md): Nakamura's non-isothermal form of the
     isothermal Avrami law with a Hoffman-Lauritzen half time. Defaults: the PA12 values of
-    docs/pa12_process.md (``studies.references.crystallization.PA12_CRYSTALLIZATION``), of which
-    n, T_m0_C and K_g_K2 are modelling choices and inv_t_half_0_1_s is calibrated to a 146 C DSC
-    peak at 10 K/min."""
+    docs/record/pa12_process.md (``studies.references.crystallization.PA12_CRYSTALLIZATION``), of
+    which n, T_m0_C and K_g_K2 are modelling choices and inv_t_half_0_1_s is calibrated to a 146 C
+    DSC peak at 10 K/min."""
 
     n: float = Field(3.0, ge=1.0, le=4.0, description="Avrami exponent n, in [1, 4]")
     inv_t_half_0_1_s: float = Field(
@@ -47,7 +47,7 @@ class Material(Model):
         None,
         description="a bundled material whose values fill this table, the keys written beside "
         "it overriding them (config/presets.py): pa12_process, PA12 as a machine runs it "
-        "(docs/pa12_process.md). Unset: the paper's Table 3, the defaults below",
+        "(docs/record/pa12_process.md). Unset: the paper's Table 3, the defaults below",
     )
     density_kg_m3: float = Field(1020.0, gt=0, description="rho")
     conductivity_solid_W_mK: float = Field(0.28, gt=0, description="k_c")
@@ -109,7 +109,7 @@ class Material(Model):
         "(Table 3); constant: eta = viscosity_Pas; arrhenius: a zero-shear law, the melt's "
         "Newtonian viscosity eta_0 = viscosity_ref_Pas exp(E/R (1/T - 1/T_ref)) (T in K), "
         "entered as eta = 2 eta_0 because the zero-yield Perzyna melt is Newtonian with "
-        "eta / 2 (docs/verification.md)",
+        "eta / 2 (docs/record/verification.md)",
     )
     viscosity_A_Pas: float = Field(130219.0, gt=0, description="A of the exponential law (Pa s)")
     viscosity_b_1_C: float = Field(0.02, ge=0, description="b of the exponential law (1/C)")

@@ -84,7 +84,7 @@ class Time(Model):
         description="explicit: the paper's step (eqs. 10-18), bounded by the elastic, capillary "
         "and viscous limits; implicit: backward Euler for the grid velocities (Newton on the "
         "momentum balance with the Perzyna update's secant tangent, the capillary force "
-        "semi-implicit), bounded by the heat step only (docs/implicit.md); hybrid: explicit "
+        "semi-implicit), bounded by the heat step only (docs/record/implicit.md); hybrid: explicit "
         "steps of dt_s through the laser pulse and the melting collapse, then adaptive implicit "
         "ones once every laser is off and the kinetic energy is below "
         "handover_kinetic_fraction of the surface energy (solver/handover.py)",
@@ -135,7 +135,7 @@ class Time(Model):
         description="implicit: nodes below this fraction of a full cell's mass rest (the "
         "explicit step's cut is solver.small_mass): a node that only the edges of the points' "
         "supports reach has a velocity its equations barely fix, and points nearer to it "
-        "inverted or blew up (docs/implicit.md)",
+        "inverted or blew up (docs/record/implicit.md)",
     )
     implicit_velocity_penalty: float = Field(
         0.0,
@@ -144,7 +144,7 @@ class Time(Model):
         description="implicit: 0, or a penalty on the grid velocity's second differences "
         "(zero on linear velocity fields) of this fraction of the step's largest matrix "
         "diagonal: it stiffens the near-null modes of light nodes, which only their inertia "
-        "fixes, against runaway velocities (docs/implicit.md); 1e-6 steadies hopper_pa12 at "
+        "fixes, against runaway velocities (docs/record/implicit.md); 1e-6 steadies hopper_pa12 at "
         "R0/h = 20 and time.newton_tolerance = 1e-8",
     )
     linear_solver: Literal["auto", "direct", "amg"] = Field(
@@ -160,14 +160,14 @@ class Time(Model):
         description='implicit, linear_solver = "auto": the largest direct solve, in unknowns; '
         "unset: 200000 in 2D, 40000 in 3D (a 3D row holds up to 375 entries, not 75: the "
         "Cholesky factor fills faster, and AMG-CG solves as fast near 35k unknowns; "
-        "docs/implicit.md)",
+        "docs/record/implicit.md)",
     )
     implicit_rows: Literal["auto", "dense", "blocks"] = Field(
         "auto",
         description="implicit, 3D: how the step stores each grid node's matrix rows (10 kB a "
         "node): dense over the grid (the fastest to assemble), or by blocks of 4 x 4 x 4 nodes "
         "allocated where the step writes (the nodes near material: a third of the memory for "
-        "a pair in its box, some 20 % more assembly time; docs/implicit.md); auto: blocks "
+        "a pair in its box, some 20 % more assembly time; docs/record/implicit.md); auto: blocks "
         "where the dense rows would pass 1 GiB. 2D: always dense",
     )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
@@ -222,7 +222,7 @@ class Time(Model):
         "step's deformation gradient; plastic: the equivalent plastic (viscous) strain "
         "increment, the only part of the strain whose path a step's size changes: an elastic "
         "jump (two melt surfaces snapping into contact) reaches the same quasi-static state at "
-        "any step, and the total measure chased it down to the explicit step (docs/beds.md)",
+        "any step, and the total measure chased it down to the explicit step (docs/record/beds.md)",
     )
 
 
@@ -277,7 +277,7 @@ class Solver(Model):
         "capacity, weight and the thermal field keep the physical one); the elastic and "
         "capillary time-step limits grow by sqrt(s). For slow viscous or quasi-static flow "
         "(Ohnesorge >> 1); the kinetic_ratio monitor says when inertia starts to matter "
-        "(docs/speed.md)",
+        "(docs/record/speed.md)",
     )
     small_mass: float = Field(
         1e-9, ge=0, description="nodes below this fraction of a full cell's mass are skipped"

@@ -1,4 +1,4 @@
-"""The packing fraction of a bed, two ways (docs/beds.md), of discs (2D) or spheres (3D): the
+"""The packing fraction of a bed, two ways (docs/record/beds.md), of discs (2D) or spheres (3D): the
 dimension is the centres' (``c``, (n, dim)).
 
 envelope: the particles' area (volume) over the area (volume) under the bed's top profile (at

@@ -1,7 +1,7 @@
 """Bundled materials a case names instead of writing every value: ``[materials.NAME] preset =
 "pa12_process"``. Each preset is one TOML file of ``taichi_sls/materials``, the single source of
 its values: every entry holds the case key, its value, the published range and the source it
-was read from (docs/pa12_process.md renders the table from it; a test keeps the two equal).
+was read from (docs/record/pa12_process.md renders the table from it; a test keeps the two equal).
 Keys written beside ``preset`` in the case override the preset's."""
 
 from __future__ import annotations
@@ -86,7 +86,7 @@ def _cell(v: Any) -> str:
 
 def preset_table(name: str) -> str:
     """The preset as a markdown table: the case key, its value, the published range, the source
-    and a note (docs/pa12_process.md)."""
+    and a note (docs/record/pa12_process.md)."""
     data = read_preset(name)
     rows = [
         "| Case key | Value | Published range | Source | Note |",

@@ -171,7 +171,7 @@ class Contact(Model):
         "excluded, on the colour the force contours; centres: each contact's narrowest section "
         "perpendicular to the line of its bodies' centres, between the outermost crossings of "
         "the interface, on the colour neck_colour names (sub-cell, any direction; a gap "
-        "crossing the section is ignored; docs/verification.md)",
+        "crossing the section is ignored; docs/record/verification.md)",
     )
     neck_colour: Literal["filtered", "raw"] = Field(
         "filtered",
@@ -181,7 +181,7 @@ class Contact(Model):
         "it closes the one-cell notch the points of two bodies leave along a node-line "
         "mid-plane: Hopper within 3 % at tau = 0.5-3, R0/h = 20); raw: the cell fraction "
         "itself (the seeded outline; a concave neck of curvature kappa reads about kappa h^2 "
-        "narrower than filtered, the notch read as it is; docs/verification.md)",
+        "narrower than filtered, the notch read as it is; docs/record/verification.md)",
     )
     settle: bool = Field(
         False,
@@ -192,14 +192,14 @@ class Contact(Model):
         "time.max_s), then the clock, the points' start positions and the integrator begin "
         "again there and the lasers act on their own times. The settled neck is the verdict's "
         "unheated baseline (no separate run). false: the laser meets the bodies as seeded "
-        "(jobs/settle.py; docs/convergence.md)",
+        "(jobs/settle.py; docs/record/convergence.md)",
     )
     settle_steps: Literal["explicit", "implicit"] = Field(
         "explicit",
         description="settle: the steps that settle the bodies. explicit: the case's own (the "
         "hybrid's explicit steps until its hand-over rule holds); implicit: the adaptive "
         "implicit step from the start (backward Euler damps the ringing instead of stepping "
-        "through it; needs time.integrator = hybrid or implicit; docs/convergence.md)",
+        "through it; needs time.integrator = hybrid or implicit; docs/record/convergence.md)",
     )
 
 
@@ -232,7 +232,7 @@ class Thermal(Model):
         ge=0,
         le=1,
         description="top_surface = chamber: the surface's emissivity (PA12 0.90-0.92, "
-        "docs/pa12_process.md)",
+        "docs/record/pa12_process.md)",
     )
     convection_W_m2K: float = Field(
         0.0, ge=0, description="top_surface = chamber: the convection coefficient h (W/(m^2 K))"

@@ -1,5 +1,5 @@
 """What a laser did to a powder layer as a whole: its relative density before and after, and the
-depth and width of the melt track (docs/beds.md).
+depth and width of the melt track (docs/record/beds.md).
 
 Relative density: the area where the raw colour c >= 1/2 (the material as the capillary force
 and the necks see it) over the area of the layer's envelope, the region under its top profile

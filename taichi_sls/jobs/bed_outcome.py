@@ -2,7 +2,7 @@
 at the end of its melting and at the end, whether its neck region melted through and whether it
 fused; for the layer, its relative density before and after and the melt track's depth and width
 (jobs/bed_layer.py). The pair verdict of jobs/outcome.py reads bodies 0 and 1 only; a bed gets
-this one instead (docs/beds.md).
+this one instead (docs/record/beds.md).
 
 Per contact (a, b) of ``Simulation.contacts``:
 

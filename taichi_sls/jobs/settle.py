@@ -4,11 +4,11 @@ A powder held at its bed temperature has had its particles touching for seconds 
 reaches them: a soft solid with a surface energy has zipped its contacts open elastically until
 the adhesion balances the stored energy (jobs/unheated.py), and nothing rings any more. Seeded
 discs (with or without a fillet) are not at that equilibrium, so a laser switched on at once
-melts a contact that still swings, and the neck it leaves carries that swing (docs/convergence.md,
-"The laser meets the settled pair"). Here the scene first steps with every laser absorbing
-nothing until the stop rule of a case no laser heats holds (jobs/schedule.py, ``settled``:
-the kinetic energy quiet and the first contact's neck held over the frames before), checked on
-the output's log-spaced frame times; then the clock restarts at t = 0 from that state
+melts a contact that still swings, and the neck it leaves carries that swing
+(docs/record/convergence.md, "The laser meets the settled pair"). Here the scene first steps with
+every laser absorbing nothing until the stop rule of a case no laser heats holds (jobs/schedule.py,
+``settled``: the kinetic energy quiet and the first contact's neck held over the frames before),
+checked on the output's log-spaced frame times; then the clock restarts at t = 0 from that state
 (``Simulation.restart_clock``) and the lasers act on their own times.
 """
 

@@ -23,7 +23,7 @@ def cell_segments(f, x0, h):
     h, inside where f < 0 (linear along the edges). Returns (count, ends): up to two segments,
     ends = (ax, ay, bx, by) for each; a saddle is resolved by the mean of the four corners.
     The corners and edges are visited by run-time loops: one copy of each body (the front
-    end's cost, docs/compile.md)."""
+    end's cost, docs/record/compile.md)."""
     inside = ti.Vector([0, 0, 0, 0])
     n_in = 0
     for k in range(4):

@@ -92,7 +92,7 @@ INT_MEMBERS = ("viscosity_model", "hysteresis", "kinetics")
 KINETICS_RANGE_K = (-1.0, 0.0)
 GAS_CONSTANT = 8.314462618  # J/(mol K)
 # With kinetics a point counts as molten (time_molten) while under 1 % crystallised: its
-# fraction leaves 0 as soon as it cools below T_m0 (docs/pa12_process.md: "essentially
+# fraction leaves 0 as soon as it cools below T_m0 (docs/record/pa12_process.md: "essentially
 # amorphous", avrami_time_to(0.01))
 KINETICS_MOLTEN = 0.01
 
@@ -174,7 +174,7 @@ def viscosity(mp: ti.template(), T):
     """The Perzyna viscosity eta of eq. 41. Table 3: eta = A exp(-b T[C]) (T in C as printed),
     or a constant; or Arrhenius's zero-shear law eta_0 = eta_ref exp(E/R (1/T - 1/T_ref)) taken
     as the melt's Newtonian viscosity: the zero-yield Perzyna melt is Newtonian with eta / 2
-    (docs/verification.md), so eta = 2 eta_0."""
+    (docs/record/verification.md), so eta = 2 eta_0."""
     eta = mp.viscosity_Pas
     if mp.viscosity_model == ViscosityModel.EXPONENTIAL:
         eta = mp.viscosity_A_Pas * ti.exp(-mp.viscosity_b_1_C * (T - KELVIN))

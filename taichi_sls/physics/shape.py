@@ -12,7 +12,7 @@ from .small_matrix import ZERO_MATRIX, ZERO_VECTOR
 # The node offsets of a point's stencil, 3 per axis, by dimension (``domain.dim``, 2 or 3). Loops
 # over them run at run time, `for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim]))`: a
 # `ti.static` loop would make the front end build its body 3^dim times at every call site
-# (docs/compile.md).
+# (docs/record/compile.md).
 STENCIL_SHAPE = {dim: (3,) * dim for dim in (2, 3)}
 
 

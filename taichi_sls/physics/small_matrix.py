@@ -3,8 +3,8 @@
 Taichi's ``@`` unrolls a product at Python level: a 3x3 product is 27 multiply-adds that its
 front end builds node by node at every call site, and the finite-strain update holds nine of
 them, expanded again in each kernel that updates stress (a third of the front end's work on a
-warm start, docs/compile.md). A run-time loop is built once per call site; each entry sums its
-terms in the same order as Taichi's ``@``.
+warm start, docs/record/compile.md). A run-time loop is built once per call site; each entry sums
+its terms in the same order as Taichi's ``@``.
 """
 
 from taichi_sls.backend import ti

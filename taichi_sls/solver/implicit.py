@@ -371,15 +371,16 @@ class ImplicitStepper:
                     f"{where}: Newton did not converge in {it} iterations (residual "
                     f"{np.linalg.norm(R) / scale:.2e} of the force scale, tolerance {self.tol:g}); "
                     "try a smaller time.dt_s or a larger time.newton_max_iterations, or where "
-                    "light nodes run away (docs/implicit.md) time.implicit_velocity_penalty = 1e-6"
+                    "light nodes run away (docs/record/implicit.md) "
+                    "time.implicit_velocity_penalty = 1e-6"
                 )
             try:
                 dv = self.linear.solve(A, -R, refresh=fresh)
             except LinearSolveError as e:  # an adaptive run redoes the step smaller
                 raise NewtonError(
                     f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "
-                    "and stiffness leaves the matrix near singular (docs/implicit.md): try a "
-                    "smaller time.dt_s or time.implicit_velocity_penalty = 1e-6"
+                    "and stiffness leaves the matrix near singular (docs/record/implicit.md): "
+                    "try a smaller time.dt_s or time.implicit_velocity_penalty = 1e-6"
                 ) from e
             fresh = False
             norm0 = np.linalg.norm(R)

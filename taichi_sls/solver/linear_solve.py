@@ -36,7 +36,7 @@ class LinearSolveError(RuntimeError):
     with a fresh preconditioner did not converge."""
 
 
-# time.direct_max_unknowns unset: the largest direct solve by dimension (docs/implicit.md)
+# time.direct_max_unknowns unset: the largest direct solve by dimension (docs/record/implicit.md)
 DIRECT_MAX_UNKNOWNS = {2: 200_000, 3: 40_000}
 
 

@@ -14,7 +14,7 @@ from .monitor import neck_measures
 from .neck_section import equivalent_radii, filtered_colour, neck_section, pair_reach
 
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
-# own to_numpy is a kernel of its own, compiled in every process: docs/compile.md)
+# own to_numpy is a kernel of its own, compiled in every process: docs/record/compile.md)
 HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
 HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
 

@@ -33,7 +33,7 @@ class Layout(IntEnum):
     BLOCKS = 2  # one call per step, points by blocks in four colours (every CPU core)
 
 
-# the blocks layout pays for itself above about this many points (docs/speed.md)
+# the blocks layout pays for itself above about this many points (docs/record/speed.md)
 BLOCKS_FROM_POINTS = 20_000
 T_RUNAWAY_K = 1e4  # no polymer state of this model lives above it (the guard's bound too)
 
@@ -148,7 +148,7 @@ def choose_layout(case: Case, n_points: int) -> Layout:
     """``solver.layout``; "auto": parallel on a GPU; on a CPU the blocks layout for large 2D
     scenes when there is more than one thread, else the serial one (3D on a CPU: serial, as the
     parallel layout's atomic scatters cost 2.6x its CPU time and were slower in wall time too;
-    docs/speed.md, ``taichi-sls bench speed3d``)."""
+    docs/record/speed.md, ``taichi-sls bench speed3d``)."""
     lay = case.solver.layout
     if lay != "auto":
         return Layout[lay.upper()]

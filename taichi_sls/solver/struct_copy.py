@@ -10,7 +10,8 @@ f32, f64 and i32 members the solver's structs hold), with the same values as Tai
 Which field, which members and which way are chosen at run time (a column per member, or -1),
 so the struct fields of one :class:`CopyGroup` (a run's state: :func:`share_kernel`) compile
 one kernel for all their copies; a kernel's compilation costs tens of ms whatever its size
-(docs/compile.md). A field's copies range over the members :func:`copies_among` names, or all.
+(docs/record/compile.md). A field's copies range over the members :func:`copies_among` names, or
+all.
 """
 
 from collections.abc import Iterable, Mapping

@@ -7,7 +7,7 @@ code underlined, wrapped by ``textwrap``) into the node's debug info. A ``ti.fun
 and visited again at each call site, and a ``ti.static`` loop visits its body once per
 iteration, so the same excerpt is formatted many times: that formatting was about half of the
 front end's time, and reading the function's source again (``inspect`` tokenizes its module
-to find it) at each call site a quarter of the rest (docs/compile.md). This memoizes both: an
+to find it) at each call site a quarter of the rest (docs/record/compile.md). This memoizes both: an
 excerpt by the node's position in its source, the source by the function. The texts are the
 same, byte for byte, as Taichi's, so error messages do not change; a source file edited while
 the process runs is read as it was at its first compile (as Python's own ``linecache``).

@@ -1,7 +1,7 @@
 """bench/spherepair.py: two liquid spheres coalescing in 3D (no heat). A short look at
 R/h = 4 (25 s: slow): the neck grows from the seeded contact and the volume is kept; the
 octant under mirrors runs the whole pair; the models and the report (bench/
-sphere_pair_report.py). The study's figures are in docs/verification.md."""
+sphere_pair_report.py). The study's figures are in docs/record/verification.md."""
 
 import math
 

@@ -20,7 +20,7 @@ from taichi_sls.solver.scene import build_scene
 # Europhys. Lett. 4, 1385, 1987). Random close packing is 0.84 for discs (Meer et al. 2024,
 # arXiv:2404.02316: phi_0 = 0.840 at low skewness) and 0.64 for spheres; random loose packing
 # of spheres 0.55. 2D: six seeds of the 1000-disc bed below read 0.818-0.827 in the bulk
-# window. 3D: six seeds of a 2000-sphere periodic bed read 0.577-0.583 (docs/beds.md); 0.015
+# window. 3D: six seeds of a 2000-sphere periodic bed read 0.577-0.583 (docs/record/beds.md); 0.015
 # is the sampling scatter of a core of ~1100 spheres (a few 0.001) plus the spread of the
 # published figures (0.58-0.59). Both bands are 0.015 wide.
 DEPOSITION_2D, RCP_2D = 0.82, 0.84

@@ -1,5 +1,5 @@
 """Bundled materials (config/presets.py): ``[materials.NAME] preset = "pa12_process"`` loads
-every value of taichi_sls/materials/pa12_process.toml, the table of docs/pa12_process.md is
+every value of taichi_sls/materials/pa12_process.toml, the table of docs/record/pa12_process.md is
 rendered from that file, and a bad name is one line."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from taichi_sls.config import CaseError, Material, case_to_toml, load_case
 from taichi_sls.config.loading import case_from_dict
 from taichi_sls.config.presets import preset_names, preset_table, read_preset
 
-DOCS = Path(__file__).resolve().parents[2] / "docs" / "pa12_process.md"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "record" / "pa12_process.md"
 PRESET = "pa12_process"
 BEGIN, END = f"<!-- preset {PRESET} -->\n", f"<!-- /preset {PRESET} -->"
 
@@ -82,11 +82,11 @@ def test_an_unknown_preset_is_one_line_naming_key_value_and_names():
 
 
 def test_the_docs_table_is_rendered_from_the_preset_file():
-    """docs/pa12_process.md holds the preset's table as config.presets.preset_table renders it
-    (regenerate: see the docs page)."""
+    """docs/record/pa12_process.md holds the preset's table as config.presets.preset_table renders
+    it (regenerate: see the docs page)."""
     text = DOCS.read_text()
     found = re.search(re.escape(BEGIN) + "(.*?)" + re.escape(END), text, re.S)
-    assert found, f"docs/pa12_process.md has no {BEGIN.strip()} block"
+    assert found, f"docs/record/pa12_process.md has no {BEGIN.strip()} block"
     assert found.group(1) == preset_table(PRESET)
 
 

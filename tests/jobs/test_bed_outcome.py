@@ -77,7 +77,7 @@ def test_one_row_per_contact_with_the_fillet_neck_at_the_start(runs):
     """Every tangency is a row, at its tangency point, with a finite initial neck. The fillet
     neck (rho = 2 um) is 14.33 um between the 20 um discs and 11.97 um to the 12 um disc; at
     h = 4 um the colour fills each cusp by up to a cell (the pair reads 17.40 for 14.33,
-    docs/convergence.md), so the neck read lies between the fillet's and one cell more."""
+    docs/record/convergence.md), so the neck read lies between the fillet's and one cell more."""
     case, folder = runs["laser"]
     rows = _table(folder)
     assert [(int(r["body_a"]), int(r["body_b"])) for r in rows] == TANGENT

@@ -39,7 +39,7 @@ def test_settling_restarts_the_clock_at_a_quiet_state_and_puts_the_laser_back():
         assert abs(r["neck_um"] / seeded["contact_line_um"] - 1.0) > 1e-3
     # backward Euler damps the ringing the explicit steps go through, to the same contact: the
     # necks agree within 0.1 %, in fewer steps (half here; a tenth and less on finer grids,
-    # where the explicit contact rings longer: docs/convergence.md)
+    # where the explicit contact rings longer: docs/record/convergence.md)
     assert abs(record["neck_um"] / explicit["neck_um"] - 1.0) < 1e-3
     assert record["steps"] < explicit["steps"]
     # no laser heat while settling: the pair is still at its initial temperature

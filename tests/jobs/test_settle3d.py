@@ -3,7 +3,7 @@ pair of spheres joined by the torus fillet (R = 8 um, h = 2 um) settles, then a 
 laser heats it without melting, and the run stops once solid and quiet with a verdict whose
 necks are all read (no NaN). The settle rule is loosened (kinetic fraction 1, neck change
 100 %) so that it holds within a few frames: the test checks that the 3D machinery runs and
-reads its necks, not the settled state itself (docs/convergence.md for that, in 2D)."""
+reads its necks, not the settled state itself (docs/record/convergence.md for that, in 2D)."""
 
 import csv
 import math

@@ -62,7 +62,7 @@ def test_laplace_pressure_of_a_static_disc():
     print("Laplace, R/h = 10:", r.errors, r.info)
     # measured: pressure -1.1 %, |v|max 4.5e-3 m/s = 3.4e-3 of the capillary velocity
     # sqrt(gamma / rho R), capillary number eta_N |v| / gamma = 0.037 (the 1e-3 is
-    # missed; docs/verification.md). Tolerances: 2 % on the pressure; spurious velocities
+    # missed; docs/record/verification.md). Tolerances: 2 % on the pressure; spurious velocities
     # under 1 % of the capillary velocity
     assert abs(r.errors["pressure"]) < 0.02
     assert r.info["v_over_capillary"] < 1e-2

@@ -137,7 +137,7 @@ def test_hopper_shape_seeds_the_exact_outline():
 def test_colour_contact_line_of_the_paper_pair():
     """The colour interface's contact line of the paper's pair at t = 0 (no r_p): 13.58 um at
     h = 2 um with the colour filter, 9.33 um without (the filter bridges gaps about twice as
-    wide; both fall as sqrt(h): touching circles meet in a point, docs/verification.md); the
+    wide; both fall as sqrt(h): touching circles meet in a point, docs/record/verification.md); the
     level set of eq. 21 gives the paper's 8.27 um beside it. All on the vertical node column
     (contact.neck_section = "column"). The section across the centres reads the colour that
     contact.neck_colour names whatever the force's filter: filtered (the default), the
@@ -175,7 +175,7 @@ def test_surface_energy_is_the_default_and_csf_stays_reachable():
 def test_laplace_pressure_and_spurious_currents():
     """A disc of Maxwell fluid at rest (cases/verification/laplace.toml at R/h = 10, gamma ramped
     in over 20 us, APIC) carries gamma / R (2D Laplace law). Measured +0.8 %, Ca 0.014 at
-    R/h = 10 (docs/verification.md). Tolerance: the issue's 2 %; Ca below 0.02, half the 0.06
+    R/h = 10 (docs/record/verification.md). Tolerance: the issue's 2 %; Ca below 0.02, half the 0.06
     that the CSF left at R/h = 20 before this force, with the margin that keeps the check off
     round-off."""
     r = ver.run(ver.load("laplace", 10))
@@ -231,7 +231,7 @@ def test_hopper_from_touching_discs_R0_h_20():
     past the discs' initial diameter from tau ~1.45 on (measured -2.87 / -2.11 / -0.38 /
     -0.10 %; 25 min on two crowded cores; the raw colour read -13.5 / -4.7 / -0.36 / +0.40 %:
     it keeps the one-cell notch along the node-line mid-plane that the filter closes;
-    docs/verification.md)."""
+    docs/record/verification.md)."""
     r = ver.run(ver.load("hopper", 20))
     print(r.errors)
     for k in ("neck_tau0.5", "neck_tau1", "neck_tau2", "neck_tau3"):

@@ -3,7 +3,8 @@
 b ~ I read to round-off, and the implicit step's Newton converging on it. Taichi's ti.sym_eig
 (Cardano's closed form) lost the small strain b - I to cancellation (log b off by 25-100 % at
 |b - I| = 1e-5..1e-2), so the stress jumped with round-off changes of the velocity and the 3D
-pair's Newton stalled at 5e-2 of its force scale (cases/pair3d_25W.toml, docs/results.md)."""
+pair's Newton stalled at 5e-2 of its force scale (cases/pair3d_25W.toml,
+docs/record/paper_reading.md)."""
 
 import numpy as np
 import pytest

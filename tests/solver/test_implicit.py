@@ -353,7 +353,7 @@ def test_implicit_hopper_from_his_outline_at_ten_times_the_capillary_limit():
 def test_the_velocity_penalty_steadies_a_second_of_sintering_at_a_tight_tolerance():
     """hopper_pa12 at R0/h = 20 and time.newton_tolerance = 1e-8: without the penalty light
     nodes at the neck's edges run away (Newton fails near 0.7 s, or the area drifts 9 %;
-    docs/implicit.md); with time.implicit_velocity_penalty = 1e-6 the run completes, r_n / R0
+    docs/record/implicit.md); with time.implicit_velocity_penalty = 1e-6 the run completes, r_n / R0
     within the issue's 3 % of Hopper at tau = 0.5 and 1 and the area within 0.5 %, as at the
     default tolerance without it."""
     sets = {"time": {"newton_tolerance": 1e-8, "implicit_velocity_penalty": 1e-6}}

@@ -1,6 +1,6 @@
 """A bed sweep's collection and figure: dotted names reach into a run's summary (the bed's
 record), and the bed map is drawn from a results.csv of those columns (synthetic rows: the
-bundled sweep itself runs on request, docs/sweeps.md)."""
+bundled sweep itself runs on request, docs/record/sweeps.md)."""
 
 import math
 

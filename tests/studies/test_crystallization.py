@@ -75,7 +75,7 @@ def test_avrami_time_to_inverts_the_closed_form():
 # so the peak is checked for the direction (falls as the rate rises) over that range and
 # against the one crystallisation temperature read, T_c = 146 C (Maeshima, Kim & Zohdi 2020,
 # Table 3), to which inv_t_half_0 is calibrated at 10 K/min: a calibration check, not an
-# independent one (docs/pa12_process.md).
+# independent one (docs/record/pa12_process.md).
 RATES_K_PER_MIN = [0.2, 1.0, 2.0, 5.0, 10.0, 20.0]
 
 

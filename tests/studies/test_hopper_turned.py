@@ -49,7 +49,7 @@ def test_turned_pair_from_the_outline_keeps_its_frame():
 def test_turned_pair_follows_hopper_at_R0_h_20():
     """Hopper's outline at tau0 = 0.5 turned by 45 deg, R0/h = 20: r_n / R0 on the turned
     mid-plane against Hopper at tau = 0.5 (the start: the seeding's error), 1, 2, 3; measured
-    +2.93 / +0.36 / +0.03 / -0.10 %, area -0.05 % (aligned: docs/verification.md). Tolerance:
+    +2.93 / +0.36 / +0.03 / -0.10 %, area -0.05 % (aligned: docs/record/verification.md). Tolerance:
     3 %, the bar of the per-contact sections (issue #40 item 6); 0.5 % on the area."""
     sets = {"verification": {"hopper_tau0": 0.5, "hopper_angle_deg": 45.0}}
     r = ver.run(ver.load("hopper_shape", 20, sets))

@@ -1,6 +1,6 @@
 """The process studies' machinery (taichi_sls/studies/process): the measured-density file and its
 loader, the sweeps' design read from the base case, the summaries and figures, and a tiny energy
-sweep run on the Dask runner end to end (the full studies: docs/sweeps.md, run by hand)."""
+sweep run on the Dask runner end to end (the full studies: docs/record/sweeps.md, run by hand)."""
 
 from __future__ import annotations
 
@@ -242,8 +242,9 @@ def test_the_ids_follow_the_bases_contents(tmp_path):
 def test_the_process_studies_rise_with_energy_and_stop_near_the_crystallisation_range(tmp_path):
     """The energy and bed-temperature studies in full (40 min on two shared cores): at the
     0.1 mm hatch the density gained rises with the Andrew number, and densification stops
-    within 3 K of the base's crystallisation range on cooling (docs/sweeps.md), on the base those
-    figures were measured on (a fixed range; the bundled base now crystallises by kinetics)."""
+    within 3 K of the base's crystallisation range on cooling (docs/record/sweeps.md), on the base
+    those figures were measured on (a fixed range; the bundled base now crystallises by
+    kinetics)."""
     out = tmp_path / "process"
     base = ROOT / "tests" / "data" / "machine_layer_range.toml"  # the range the threshold meets
     args = ["bench", "process", "--base", str(base), "--only", "energy", "bed", "--out", str(out)]

@@ -35,8 +35,8 @@ def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path,
     heat): the pulse melts the pair, it cools to the 170 C bed and stays molten (it crystallises
     only below 150 C), and its neck follows Hopper's at the recorded
     temperature within the issue's 3 % at 1 s (measured -0.5 to -1.2 % over four sets of step
-    controls, docs/implicit.md), within 6 % from 0.1 s on (measured up to +5.1 %: the clock runs
-    at the pair's mean temperature, and while the pair cools its neck is hotter than the mean);
+    controls, docs/record/implicit.md), within 6 % from 0.1 s on (measured up to +5.1 %: the clock
+    runs at the pair's mean temperature, and while the pair cools its neck is hotter than the mean);
     molten and at 170 C throughout the hold; the neck has grown by 2.5 times. The same with the
     step controlled by the plastic (viscous) strain increment instead of the total one (measured
     -0.6 % at 1 s, at most +3.1 %, in 211 steps against 542)."""

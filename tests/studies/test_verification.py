@@ -118,8 +118,8 @@ def test_laser_spot_on_a_3d_half_space():
     """A stationary Gaussian spot absorbed with eq. 31's depth law on an insulated 3D block,
     against the half-space's solution at t = r0^2 / (8 alpha) (references.
     gaussian_spot_halfspace). Measured at the top points nearest the axis: -13.7 % at h = 8 um,
-    -3.58 % at h = 4 um, -0.915 % at h = 2 um (order 1.93, 1.97) (docs/verification.md, "3D").
-    Tolerance: 5 % at h = 4 um (r0 / h = 5, eta / h = 2.5), the measured error's second-order
+    -3.58 % at h = 4 um, -0.915 % at h = 2 um (order 1.93, 1.97) (docs/record/verification.md,
+    "3D"). Tolerance: 5 % at h = 4 um (r0 / h = 5, eta / h = 2.5), the measured error's second-order
     trend with a margin; a spot a factor off (the 0.6, A, r0 read as a 1/e^2 or 1/e radius)
     misses by 20 % and more. The error is an underestimate at every h (the grid smooths)."""
     r = ver.run(ver.load("spot3d", 4.0))
@@ -131,7 +131,7 @@ def test_laser_spot_on_a_3d_half_space():
 def test_viscous_decay_of_a_disc_mode_at_coarse_resolution():
     """R/h = 10: the fitted decay rate of the n = 2 mode against n gamma / (2 eta_N R) (Stokes
     flow of a disc). Measured with the surface-energy force and APIC -16.5 %; -2.7 % at
-    R/h = 20 (docs/verification.md). Tolerance: 20 % at R/h = 10, the coarse grid's bias; the
+    R/h = 20 (docs/record/verification.md). Tolerance: 20 % at R/h = 10, the coarse grid's bias; the
     convergence is the slow study's."""
     r = ver.run(ver.load("viscous_decay", 10))
     print("viscous decay, R/h = 10:", r.errors, r.info)

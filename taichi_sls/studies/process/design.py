@@ -1,11 +1,11 @@
-"""The three process studies of a PA12 layer as sweeps on the Dask runner (docs/sweeps.md, "What
-a process engineer reads"): the energy density (power x scan speed x hatch), the bed
+"""The three process studies of a PA12 layer as sweeps on the Dask runner (docs/record/sweeps.md,
+"What a process engineer reads"): the energy density (power x scan speed x hatch), the bed
 temperature, and the sensitivity of the density to the uncertain inputs.
 
 Every case starts from a base case (default ``cases/machine_layer.toml``; any hatched layer with
 ``lasers.0.scan = "across"``) made smaller by ``REDUCTION``: a 0.3 mm bed (about 19 discs of
 40 um) under two tracks centred on it, held 5 s instead of the layer's 10 s. The density of
-that layer has levelled off by then (docs/sweeps.md has the full-length check, which the
+that layer has levelled off by then (docs/record/sweeps.md has the full-length check, which the
 sensitivity sweep reruns as its ``layer time`` row). Values that scale the base's own inputs
 (viscosity x2, surface tension +-20 %, ...) are read from the base, so the same command reruns
 the studies on another material.

@@ -1,5 +1,5 @@
 """Published PA12 part densities, each with its source: the package's
-``studies/references/data/pa12_density_energy.csv`` (docs/pa12_process.md, "Density against
+``studies/references/data/pa12_density_energy.csv`` (docs/record/pa12_process.md, "Density against
 energy density"). Columns: ``source`` (author or document), ``where`` (table, figure, line),
 ``kind`` (how the value was obtained: ``table``, ``text``, ``figure (digitised)``, ``data sheet``
 ..., any text naming it), ``material``, ``process``, ``energy_density_J_mm2`` (Andrew number

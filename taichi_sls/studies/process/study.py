@@ -1,5 +1,5 @@
 """``taichi-sls bench process``: the three process studies of a PA12 layer in one command, on the
-Dask sweep runner (docs/sweeps.md, "What a process engineer reads").
+Dask sweep runner (docs/record/sweeps.md, "What a process engineer reads").
 
     taichi-sls bench process [--base CASE] [--only energy bed sensitivity] [--out DIR]
                              [--figures DIR] [--workers N] [--scheduler ADDRESS] [--set K=V ...]

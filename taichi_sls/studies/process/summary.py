@@ -86,7 +86,7 @@ def sensitivity_summary(results_csv: str | Path, ids: set[str] | None = None) ->
         factors.setdefault(k, {})
         gains.setdefault(k, {})
     # largest change of the gain first: on a bed of a few tens of discs the settled packing itself
-    # moves by points between draws (docs/sweeps.md), so the gain is what the factor does
+    # moves by points between draws (docs/record/sweeps.md), so the gain is what the factor does
     ordered = sorted(
         factors.items(), key=lambda kv: -max([abs(v) for v in gains[kv[0]].values()] + [0])
     )

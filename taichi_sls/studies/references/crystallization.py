@@ -10,7 +10,7 @@ The rate law K_N(T) is the Hoffman-Lauritzen form used for such models (e.g. Pat
 Guo, Isayev & Guo 1999), 1/t_1/2 = (1/t_1/2)_0 exp(-U/(R (T - T_inf))) exp(-K_g/(T dT f)),
 dT = T_m0 - T, f = 2 T / (T + T_m0), K_N = (ln 2)^(1/n) / t_1/2.
 
-:data:`PA12_CRYSTALLIZATION` holds the PA12 values of docs/pa12_process.md; which of them are
+:data:`PA12_CRYSTALLIZATION` holds the PA12 values of docs/record/pa12_process.md; which of them are
 measured and which are modelling choices is said there and in :class:`CrystallizationKinetics`.
 The solver's kernels evaluate the same law per point (physics/materials.py, the option
 ``materials.NAME.crystallization_kinetics``); this module is their host-side reference.
@@ -79,7 +79,7 @@ class CrystallizationKinetics:
 
 
 # PA12 (laser-sintering powder). n, T_m0, K_g are modelling choices and inv_t_half_0 is
-# calibrated to one crystallisation temperature; docs/pa12_process.md gives the ranges tried.
+# calibrated to one crystallisation temperature; docs/record/pa12_process.md gives the ranges tried.
 PA12_CRYSTALLIZATION = CrystallizationKinetics(
     n=3.0,  # modelling choice (spherulitic growth; tried 2-3); Zhao et al. 2018's fit unread
     inv_t_half_0=9.072e4,  # calibrated: DSC peak 146 C at 10 K/min from 185 C (Maeshima T_c)

@@ -1,7 +1,7 @@
 """A bed sweep's figure from its ``results.csv``: what the layer became across the process window.
 
 :func:`plot_bed_map` draws, for the rows that collected a bed's record (``bed.fused_fraction``,
-``bed.relative_density.initial`` and ``.final``; docs/beds.md), the fused fraction of the
+``bed.relative_density.initial`` and ``.final``; docs/record/beds.md), the fused fraction of the
 contacts and the relative density gained as maps of laser power (y) against scan speed (x), and
 both against the line energy P / v (J/m) that sets how much heat a unit length of track takes.
 """
