@@ -59,7 +59,8 @@ def init_taichi(
         default_fp=ti.f64 if precision == "f64" else ti.f32,
         offline_cache=True,
         # Taichi's default keeps 100 MB and drops the least recently used quarter: a "warm" start
-        # after a few cases and the suite would compile a part of its kernels again (compile.md)
+        # after a few cases and the suite would compile a part of its kernels again
+        # (docs/record/compile.md)
         offline_cache_max_size_of_files=OFFLINE_CACHE_BYTES,
         unrolling_limit=0,  # struct_copy unrolls over a struct's members on purpose: no warning
         advanced_optimization=optimize,
