@@ -1,5 +1,5 @@
-"""A bed's CSV files (docs/record/beds.md): their columns read with one clear error per bad row, and a
-CSV bed's particles checked (discs in 2D, spheres in 3D: the dimension is the domain's).
+"""A bed's CSV files (docs/record/beds.md): their columns read with one clear error per bad row,
+and a CSV bed's particles checked (discs in 2D, spheres in 3D: the dimension is the domain's).
 
 A CSV bed is a previous layer as measured or exported: it is checked (rows, overlaps, support,
 domain) and the generator, if asked for particles too, deposits them on top of it. A floating
