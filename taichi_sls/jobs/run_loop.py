@@ -15,7 +15,7 @@ import math
 import signal
 import threading
 import time
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -153,8 +153,9 @@ class Pacer:
 
     def advance_to(self, t: float) -> None:
         sim = self.sim
-        if sim.adaptive is not None:  # steps that land on t
-            self._timed(t)
+        if sim.adaptive is not None:  # steps that land on t; a stop request ends one early
+            with self.stops.held():
+                self._timed(t, stop=lambda: self.stops.pending)
             return
         while (left := round((t - sim.t) / sim.dt)) > 0:
             n = min(left, self.chunk)
@@ -163,9 +164,9 @@ class Pacer:
             grown = round(n * CHUNK_WALL_S / max(wall, 1e-9))
             self.chunk = max(1, min(CHUNK_GROWTH * n, grown))
 
-    def _timed(self, t: float) -> float:
+    def _timed(self, t: float, stop: Callable[[], bool] | None = None) -> float:
         w0 = time.perf_counter()
-        self.sim.advance_to(t)
+        self.sim.advance_to(t, stop)
         wall = time.perf_counter() - w0
         self.step_wall += wall
         for tick in self.ticks:

@@ -266,4 +266,6 @@ class AdaptiveStepper:
             n += 1
             if hooks.after is not None:
                 hooks.after()
+            if hooks.stopping():
+                break
         return n

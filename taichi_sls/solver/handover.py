@@ -189,8 +189,10 @@ class HybridStepper:
                 k = min(n, h.steps_to_check())
                 taken += whole_steps(self.explicit.take, k, hooks)
                 h.check(self._t(), k)
-                continue
-            taken += self.adaptive.advance_to(t, hooks)
-            if self._t() < t * (1.0 - 1e-12):  # stopped short: the explicit steps take over
-                h.hand_back(self._t())
+            else:
+                taken += self.adaptive.advance_to(t, hooks)
+                if self._t() < t * (1.0 - 1e-12) and not hooks.stopping():
+                    h.hand_back(self._t())  # stopped short: the explicit steps take over
+            if hooks.stopping():
+                break
         return taken

@@ -192,13 +192,14 @@ class Simulation:
         """The last step taken (s): ``dt`` but with ``time.adaptive`` or after a hand-over."""
         return self.stepper.last_dt
 
-    def advance_to(self, t: float) -> None:
+    def advance_to(self, t: float, stop: Callable[[], bool] | None = None) -> None:
         """Advance until the clock reaches t (s): adaptive steps that land on it, or the whole
         fixed steps nearest to it (hybrid, explicit after a hand-back: those that reach it).
-        The one stepping verb: the case's stepper (solver/stepper.py) takes the steps."""
+        The one stepping verb: the case's stepper (solver/stepper.py) takes the steps.
+        ``stop``: asked after each adaptive step (StepHooks.stop); True ends short of t."""
         before = None if self.before_step is None else lambda: self.before_step(self)
         after = None if self.blocks is None else self._after_step
-        self.steps += self.stepper.advance_to(t, StepHooks(before, after))
+        self.steps += self.stepper.advance_to(t, StepHooks(before, after, stop))
 
     def restart_clock(self) -> None:
         """t = 0 at the state reached (contact.settle): the step count, the points' start

@@ -27,10 +27,16 @@ from .step import advance
 class StepHooks:
     """What runs between steps: ``before`` every step (a study's time-dependent load),
     ``after`` every step (the blocks layout's sort of drifted points). With neither, a fixed
-    stepper takes all its steps in one call."""
+    stepper takes all its steps in one call. ``stop``, asked after every adaptive step (and
+    every explicit chunk of a hybrid run): True ends ``advance_to`` there, short of t, at a
+    step's end, so that a stop request (Ctrl-C, SIGTERM) waits for one step, not a frame."""
 
     before: Callable[[], None] | None = None
     after: Callable[[], None] | None = None
+    stop: Callable[[], bool] | None = None
+
+    def stopping(self) -> bool:
+        return self.stop is not None and self.stop()
 
 
 NO_HOOKS = StepHooks()

@@ -56,3 +56,28 @@ def test_sigterm_stops_a_3d_run_within_two_seconds(tmp_path):
     assert "enthalpy_J" in s["final"] and "enthalpy_J_per_m" not in s["final"]  # 3D: in J
     for skipped in ("animation.gif", "timeseries.png", "contacts.png", "layer.npz"):
         assert not (out / skipped).exists(), skipped
+
+
+def test_sigterm_stops_an_adaptive_run_at_a_step_and_counts_it(tmp_path):
+    """Adaptive implicit steps land on the frame times, so they are not chunked: a stop request
+    ends the stepping at the end of the step under way (StepHooks.stop), and the steps taken
+    since the last frame are counted with the time they reached."""
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "taichi_sls.run", "sinter_hold", "--out", str(out)]
+    cmd += ["--no-progress", "--set", "output.gif=false"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        _wait_for(out / "frames" / "frame_0003.png", proc)  # stepping past the first frames
+        t0 = time.perf_counter()
+        proc.send_signal(signal.SIGTERM)
+        err = proc.communicate(timeout=120)[1]
+        stop_s = time.perf_counter() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == EXIT_CODES["interrupted"], err
+    assert stop_s < STOP_WITHIN_S, f"stopped {stop_s:.2f} s after SIGTERM"
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "interrupted" and s["steps"] >= s["final"]["step"] > 0
+    # the steps after the last frame are counted exactly when the clock went past it
+    assert (s["simulated_s"] > s["final"]["t_s"]) == (s["steps"] > s["final"]["step"])
