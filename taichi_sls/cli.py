@@ -198,7 +198,7 @@ class _Parser(argparse.ArgumentParser):
     ) -> tuple[argparse.Namespace, list[str]]:
         argv = sys.argv[1:] if args is None else list(args)
         if argv[:1] == ["sweep"]:
-            command, name, module = "sweep", "sweep", "taichi_sls.studies.sweep.runner"
+            command, name, module = "sweep", "sweep", "taichi_sls.jobs.sweep.runner"
         elif argv[:1] == ["bench"] and argv[1:2] and argv[1] in (*STUDIES, *BENCHMARKS):
             command, name, module = "bench", argv[1], None
         else:

@@ -67,7 +67,7 @@ def test_every_case_it_names_loads(name):
 
 @pytest.mark.parametrize("name", SWEEPS)
 def test_every_sweep_it_names_loads(name):
-    from taichi_sls.studies.sweep.spec import load_sweep
+    from taichi_sls.jobs.sweep.spec import load_sweep
 
     assert (ROOT / name).is_file(), f"README.md names {name}, which does not exist"
     sweep = load_sweep(ROOT / name)

@@ -4,11 +4,11 @@ bundled sweep itself runs on request, docs/record/sweeps.md)."""
 
 import math
 
-from taichi_sls.studies.sweep.bed_plots import bed_rows
-from taichi_sls.studies.sweep.draw import draw_all
-from taichi_sls.studies.sweep.results import write_results
-from taichi_sls.studies.sweep.runner import _collect
-from taichi_sls.studies.sweep.spec import load_sweep
+from taichi_sls.jobs.sweep.bed_plots import bed_rows
+from taichi_sls.jobs.sweep.draw import draw_all
+from taichi_sls.jobs.sweep.results import write_results
+from taichi_sls.jobs.sweep.runner import _collect
+from taichi_sls.jobs.sweep.spec import load_sweep
 
 SUMMARY = {
     "status": "complete",

@@ -13,6 +13,8 @@ import pytest
 
 from taichi_sls.cli import main as cli_main
 from taichi_sls.config import load_case
+from taichi_sls.jobs.sweep.runner import run_sweep
+from taichi_sls.jobs.sweep.spec import SweepError
 from taichi_sls.studies.process import plots
 from taichi_sls.studies.process.design import (
     BED_TEMPERATURE_KEYS,
@@ -25,8 +27,6 @@ from taichi_sls.studies.process.design import (
 from taichi_sls.studies.process.measured import MeasuredDataError, load_measured
 from taichi_sls.studies.process.study import report
 from taichi_sls.studies.process.summary import bed_summary, sensitivity_summary
-from taichi_sls.studies.sweep.runner import run_sweep
-from taichi_sls.studies.sweep.spec import SweepError
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = ROOT / "cases" / "machine_layer.toml"

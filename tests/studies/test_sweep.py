@@ -14,10 +14,10 @@ import pytest
 
 from taichi_sls.cli import main as cli_main
 from taichi_sls.config import bundled_case, load_case
-from taichi_sls.studies.sweep.plots import neck_growth
-from taichi_sls.studies.sweep.results import read_results
-from taichi_sls.studies.sweep.runner import run_sweep
-from taichi_sls.studies.sweep.spec import case_id, load_sweep
+from taichi_sls.jobs.sweep.plots import neck_growth
+from taichi_sls.jobs.sweep.results import read_results
+from taichi_sls.jobs.sweep.runner import run_sweep
+from taichi_sls.jobs.sweep.spec import case_id, load_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = bundled_case("power25W_coarse")
@@ -187,7 +187,7 @@ def test_the_process_map_measures_growth_against_the_verdicts_baseline():
 def test_plot_only_draws_a_results_table_without_its_run_folders(tmp_path):
     """--plot-only on a results.csv copied away from its runs: the spot radius is then unknown
     (it comes from each run's case.toml), and every figure is still drawn."""
-    from taichi_sls.studies.sweep.draw import draw_all
+    from taichi_sls.jobs.sweep.draw import draw_all
 
     rows = [(P, v) for P in (5, 25) for v in (0.0, 1.0)]
     with (tmp_path / "results.csv").open("w", newline="") as f:

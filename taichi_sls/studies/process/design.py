@@ -21,7 +21,7 @@ from typing import Any
 
 from ...config import Bed, Case, load_case
 from ...config.loading import apply_override, find_case, read_case_file
-from ..sweep.spec import Sweep, SweepCase, SweepError, case_id, toml_value
+from ...jobs.sweep.spec import Sweep, SweepCase, SweepError, case_id, toml_value
 
 DEFAULT_BASE = "cases/machine_layer.toml"
 BED_WIDTH_UM = 300.0

@@ -26,7 +26,7 @@ from typing import Any
 
 from ...config import CaseError
 from ...config.loading import add_set_argument
-from ..sweep.spec import SweepError
+from ...jobs.sweep.spec import SweepError
 from . import plots, summary
 from .design import DEFAULT_BASE, STUDIES, load_base
 from .measured import MeasuredDataError, load_measured
@@ -129,7 +129,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from ..sweep.runner import run_sweep
+    from ...jobs.sweep.runner import run_sweep
 
     out = Path(args.out)
     figures = Path(args.figures) if args.figures else out

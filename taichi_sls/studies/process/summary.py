@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ..sweep.results import read_results
+from ...jobs.sweep.results import read_results
 
 INITIAL = "bed.relative_density.initial"
 FINAL = "bed.relative_density.final"
