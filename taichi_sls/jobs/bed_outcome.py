@@ -15,10 +15,13 @@ Per contact (a, b) of ``Simulation.contacts``:
 - the necks: ``Necks.pair_necks_m``, on the colour of the two bodies alone; at the start,
   at the last output frame in which the neck region held melt (a point with liquid fraction > 0:
   the neck as that contact's melting ends; NaN for a contact that never melted), and at the end;
-- melted through: ``fusion.melted_through`` of the region's points were fully molten at some
-  time (time_molten > 0), as in the pair verdict;
-- fused: melted through, refrozen (no melt left in the region at the end) and the final neck at
-  least (1 + ``fusion.neck_growth``) times the initial neck. The baseline is the initial neck,
+- the verdict by the pair's rule (jobs/fusion_rule.py: ``contact_verdict``), the contact's own
+  inputs named: melted through, ``fusion.melted_through`` of the region's points were fully
+  molten at some time (time_molten > 0); solidified, refrozen (no melt left in the region at
+  the end); fused, melted through, refrozen and the final neck at least
+  (1 + ``fusion.neck_growth``) times the reference, the initial neck (a contact that did not
+  touch at the start, initial neck 0, passes with any final neck: ``zero_reference_grows``);
+  no verdict (no laser, not refrozen) counts as not fused. The baseline is the initial neck,
   not an unheated run: that run of a whole bed would double the cost, and the initial necks of a
   bed are the fillet's, which do not depend on h. The adhesive growth a soft solid makes without
   heat is therefore counted as growth; the same bed run without laser heat (absorptivity 0)
@@ -45,6 +48,7 @@ import numpy as np
 from ..config import Case
 from ..solver.simulation import Simulation
 from .bed_layer import layer_density, melt_extent
+from .fusion_rule import contact_verdict, melted_fraction, rule_text
 from .outcome import laser_acted
 
 NECKS = ("neck_initial_um", "neck_melt_um", "neck_final_um")
@@ -136,11 +140,18 @@ class ContactHistory:
         heated = laser_acted(sim.case)
         out = []
         for k, ((a, b), p) in enumerate(zip(self.contacts, self.points, strict=True)):
-            r = regions[k]
-            melted = float(np.mean(tm[r] > 0.0)) if r.any() else 0.0
-            through = heated and melted >= f.melted_through
+            melted = melted_fraction(tm, regions[k])
             refrozen = not self.molten_now[k]
-            grown = self.final[k] >= (1.0 + f.neck_growth) * self.initial[k]
+            verdict = contact_verdict(
+                melted,
+                float(self.final[k]),
+                float(self.initial[k]),  # a bed contact's reference: its initial neck
+                solidified=refrozen,
+                heated=heated,
+                melted_through=f.melted_through,
+                margin=f.neck_growth,
+                zero_reference_grows=True,
+            )
             out.append(
                 {
                     "body_a": a,
@@ -153,9 +164,9 @@ class ContactHistory:
                     "melt_end_s": self.melt_s[k],
                     "neck_final_um": self.final[k],
                     "neck_region_melted_fraction": melted,
-                    "melted_through": int(through),
+                    "melted_through": int(verdict.melted_through),
                     "refrozen": int(refrozen),
-                    "fused": int(bool(through and refrozen and grown)),
+                    "fused": int(bool(verdict.fused)),  # no verdict counts as not fused
                 }
             )
         return out
@@ -241,10 +252,8 @@ def bed_summary(
         "fused_fraction": float(col["fused"].mean()) if n else math.nan,
         "melted_through": int(sum(r["melted_through"] for r in rows)),
         "still_molten": int(sum(1 - r["refrozen"] for r in rows)),
-        "rule": (
-            f"per contact: neck region melted through (>= {sim.case.fusion.melted_through:g} of "
-            f"its points above T_m at some time), refrozen, and final neck >= "
-            f"(1 + {sim.case.fusion.neck_growth:g}) x initial neck"
+        "rule": "per contact: {}, refrozen, and {}".format(
+            *rule_text(sim.case.fusion.melted_through, sim.case.fusion.neck_growth, "initial neck")
         ),
         **{k: _quartiles(col[k]) for k in NECKS},
         "relative_density": {

@@ -1,14 +1,15 @@
 """The fusion outcome of a run: the neck at the start, at 1 ms, when the melt has frozen again,
 and at the end; how long the points stayed above T_m; and the verdict ``fused`` by one rule.
 
-The rule (``[fusion]``): the pair is fused when the neck region -- the points within
-``neck_region_cells`` cells of the mid-plane between bodies 0 and 1 at the start -- melted
-through (``melted_through`` of its points were fully molten at some time) and the final neck
-(contact line) exceeds the baseline neck by ``neck_growth``. The baseline (``fusion.baseline``)
-is the neck the same pair reaches unheated (jobs/unheated.py: a soft solid with a surface
-energy adheres and grows its contact without any laser), or the initial neck; the summary gives
-both, and the growth against each. The verdict needs a laser that heated
-and a solidified end state; a case without a laser, or a run that ends molten or fails, has
+The rule is the one every contact is judged by (jobs/fusion_rule.py: ``contact_verdict``): the
+pair of bodies 0 and 1 is fused when its neck region -- the points within ``neck_region_cells``
+cells of the mid-plane between them at the start -- melted through (``melted_through`` of its
+points were fully molten at some time) and the final neck (contact line) exceeds the reference
+neck by ``neck_growth``. The pair's reference is its baseline (``fusion.baseline``): the neck
+the same pair reaches unheated (jobs/unheated.py: a soft solid with a surface energy adheres and
+grows its contact without any laser), or the initial neck; the summary gives both, and the
+growth against each. The verdict needs a laser that heated and a solidified end state (the run
+completed with no melt left); a case without a laser, or a run that ends molten or fails, has
 ``fused = null`` and says why in ``no_verdict``. Every input of the rule is in the summary, so
 that a user can apply another one."""
 
@@ -20,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..config import Case
+from .fusion_rule import contact_verdict, melted_fraction, neck_growth, rule_text
 
 ONE_MS = 1e-3
 
@@ -79,40 +81,39 @@ def outcome(
     f = case.fusion
     neck0 = history.initial if history.initial is not None else math.nan
     neck_end = final["contact_line_um"]
-    melted = float(np.mean(time_molten[in_neck] > 0.0)) if in_neck.any() else 0.0
-    growth = _growth(neck_end, neck0)
+    melted = melted_fraction(time_molten, in_neck)
     unheated = baseline_um if baseline_um is not None else math.nan
     reference, reference_name = neck0, "initial neck"
     if f.baseline == "unheated":
         reference, reference_name = unheated, "unheated neck"
-    fused = None
-    no_verdict = None
-    if not laser_acted(case):
-        no_verdict = "no laser in this case"
-    elif not solidified:
-        no_verdict = "not solidified"
-    elif not math.isfinite(reference):
-        no_verdict = f"no {reference_name} (the unheated run failed)"
-    else:
-        fused = bool(melted >= f.melted_through and _growth(neck_end, reference) >= f.neck_growth)
+    verdict = contact_verdict(
+        melted,
+        neck_end,
+        reference,
+        solidified=solidified,
+        heated=laser_acted(case),
+        melted_through=f.melted_through,
+        margin=f.neck_growth,
+        reference_name=reference_name,
+    )
+    melted_clause, grown_clause = rule_text(f.melted_through, f.neck_growth, reference_name)
     return {
-        "fused": fused,
-        "no_verdict": no_verdict,
+        "fused": verdict.fused,
+        "no_verdict": verdict.no_verdict,
         "rule": (
-            f"neck region melted through (>= {f.melted_through:g} of its points above T_m at "
-            f"some time) and final neck >= (1 + {f.neck_growth:g}) x {reference_name}; needs a "
-            "solidified end state and a laser that heated"
+            f"{melted_clause} and {grown_clause}; needs a solidified end state and a laser that "
+            "heated"
         ),
         "solidified": solidified,
         "baseline": f.baseline,
         "neck_initial_um": neck0,
         "neck_unheated_um": unheated,
-        "neck_growth_over_unheated": _growth(neck_end, unheated),
+        "neck_growth_over_unheated": neck_growth(neck_end, unheated),
         "neck_1ms_um": history.at_1ms,
         "neck_refrozen_um": history.refrozen,
         "refrozen_s": history.refrozen_t,
         "neck_final_um": neck_end,
-        "neck_growth": growth,
+        "neck_growth": neck_growth(neck_end, neck0),
         "neck_region_melted_fraction": melted,
         "neck_region_points": int(in_neck.sum()),
         "time_above_melt_s": {
@@ -124,10 +125,6 @@ def outcome(
         "molten_fraction_peak_s": history.molten_peak_t,
         "T_peak_C": final.get("T_peak_C"),
     }
-
-
-def _growth(neck: float, reference: float) -> float:
-    return neck / reference - 1.0 if reference and math.isfinite(reference) else math.nan
 
 
 def describe(o: dict[str, Any]) -> str:

@@ -1,6 +1,7 @@
 """A bed's contacts (jobs/bed_outcome.py): each contact's neck and melt followed frame by frame
 (contacts.csv, and the bed's columns of the time series), the summary's ``bed`` record, its
-verdict per contact and the contacts and outcome plots at the end."""
+verdict per contact (jobs/fusion_rule.py, the pair's rule) and the contacts and outcome plots at
+the end."""
 
 from __future__ import annotations
 

@@ -15,8 +15,9 @@ from ..run_loop import Frame, Observer, RunEnd
 
 
 class PairVerdict(Observer):
-    """The summary's ``outcome`` of a pair (bodies 0 and 1) against ``baseline_um``, the
-    unheated neck when one was made (jobs/unheated.py, or the settled neck)."""
+    """The summary's ``outcome`` of a pair (bodies 0 and 1), judged by the rule of every contact
+    (jobs/fusion_rule.py) against ``baseline_um``, the unheated neck when one was made
+    (jobs/unheated.py, or the settled neck)."""
 
     key = "verdict"
     records_failed_frame = True
