@@ -15,7 +15,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +27,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Colormap, ListedColormap
+from matplotlib.contour import QuadContourSet
 from matplotlib.figure import Figure
 from scipy.ndimage import correlate1d
 
@@ -176,6 +177,36 @@ def save_png(fig: Figure, path: Path, dpi: int) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
+def checked_domain(domain_um: tuple[float, ...]) -> tuple[float, float, float, float]:
+    """The frames' (xmin, xmax, ymin, ymax) in um as floats; an empty range is an error."""
+    xmin, xmax, ymin, ymax = (float(v) for v in domain_um)
+    if not (xmax > xmin and ymax > ymin):
+        raise ValueError(f"domain_um={domain_um!r} must be (xmin, xmax, ymin, ymax), min<max")
+    return xmin, xmax, ymin, ymax
+
+
+def remove_artist(artist: Any) -> None:
+    """Take last frame's artist (an outline, a mesh) off its axes, if there is one."""
+    if artist is not None:
+        with contextlib.suppress(Exception):
+            artist.remove()
+
+
+def melt_outline(
+    ax: Axes, xs: np.ndarray, ys: np.ndarray, material: np.ndarray, liquid: np.ndarray
+) -> QuadContourSet | None:
+    """The melt outline (liquid fraction MELT_LEVEL, cyan) on an image of pixel centres ``xs``,
+    ``ys``, the void counting as solid: the outline closes along the free surface and, like the
+    material, has no gap along a mid-plane strip. None where nothing is molten."""
+    melt = np.where(material, np.nan_to_num(liquid, nan=0.0), 0.0)
+    if not (melt > MELT_LEVEL).any():
+        return None
+    try:
+        return ax.contour(xs, ys, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0)
+    except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
+        return None
+
+
 # A scene wider than this (width / height: a powder layer) stacks its two panels, each across
 # the whole frame, rather than squeezing them side by side into strips a few dozen pixels high.
 STACK_ASPECT = 2.0
@@ -195,9 +226,11 @@ def temperature_cmap(bed: bool) -> Colormap:
     return ListedColormap(base(np.linspace(BED_T_CMAP_FROM, 1.0, 256)), name="inferno_bed")
 
 
-class FramePainter:
-    """Draws one frame into a reused figure of two panels (temperature, deformation): side by
-    side, or stacked for a scene wider than STACK_ASPECT."""
+class Frame2DPainter:
+    """Draws one 2D frame into a reused figure of two panels (temperature, deformation): side
+    by side, or stacked for a scene wider than STACK_ASPECT (io/painter.FramePainter)."""
+
+    dim = 2
 
     def __init__(
         self,
@@ -207,12 +240,16 @@ class FramePainter:
         dpi: int = 80,
         bed: bool = False,
     ) -> None:
-        self.domain_um = domain_um
-        self.melt_C = melt_C
+        self.domain_um = checked_domain(domain_um)
+        self.melt_C = float(melt_C)
+        if deformation not in DEFORM_LABELS:
+            raise ValueError(
+                f"deformation={deformation!r}; allowed: {', '.join(sorted(DEFORM_LABELS))}"
+            )
         self.deformation = deformation
-        self.dpi = dpi  # the raster's pixel is one pixel of the saved image
+        self.dpi = int(dpi)  # the raster's pixel is one pixel of the saved image
         self.bed = bed
-        xmin, xmax, ymin, ymax = domain_um
+        xmin, xmax, ymin, ymax = self.domain_um
         self.stacked = (xmax - xmin) > STACK_ASPECT * (ymax - ymin)
         self._fig: Figure | None = None
 
@@ -298,7 +335,15 @@ class FramePainter:
             ax.set_title(title, fontsize=10)
         self._axes, self._contour, self._fig = axes, None, fig
 
-    def draw(self, t_s: float, x: np.ndarray, fields: dict[str, np.ndarray]) -> None:
+    def paint(
+        self, t_s: float, x: np.ndarray, fields: Mapping[str, np.ndarray], png: Path | None
+    ) -> None:
+        """The frame at ``t_s`` into ``png`` (if given); a 2D frame has no surface for the VTU."""
+        if png is not None:
+            self.draw(t_s, x, fields)
+            save_png(self._fig, png, self.dpi)
+
+    def draw(self, t_s: float, x: np.ndarray, fields: Mapping[str, np.ndarray]) -> None:
         if self._fig is None:
             self._setup_figure()
         fallback = (
@@ -324,24 +369,9 @@ class FramePainter:
             sc.set_array(np.asarray(p, dtype=float)[stray])
             sc.set_sizes(np.array([size]))
             sc.set_clim(*clim)
-        if self._contour is not None:
-            with contextlib.suppress(Exception):
-                self._contour.remove()
-            self._contour = None
-        # The melt outline on the same raster, the void counting as solid: the outline closes
-        # along the free surface and, like the material, has no gap along the mid-plane strip.
-        melt = np.where(material, np.nan_to_num(lf_px, nan=0.0), 0.0)
-        if (melt > MELT_LEVEL).any():
-            try:
-                self._contour = self._axes[0].contour(
-                    *self._pixel_centres, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
-                )
-            except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
-                self._contour = None
+        remove_artist(self._contour)
+        self._contour = melt_outline(self._axes[0], *self._pixel_centres, material, lf_px)
         self._fig.suptitle(frame_time_label(t_s))
-
-    def save(self, path: Path, dpi: int) -> None:
-        save_png(self._fig, path, dpi)
 
     def close(self) -> None:
         self._fig = None  # drop the figure; a later draw rebuilds it
