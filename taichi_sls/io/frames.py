@@ -29,6 +29,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Colormap, ListedColormap
 from matplotlib.contour import QuadContourSet
 from matplotlib.figure import Figure
+from matplotlib.image import AxesImage
 from scipy.ndimage import correlate1d
 
 from .atomic import atomic_write_bytes
@@ -192,6 +193,33 @@ def remove_artist(artist: Any) -> None:
             artist.remove()
 
 
+def blank_image(
+    ax: Axes, cmap: Colormap, shape: tuple[int, int], extent: tuple[float, ...]
+) -> AxesImage:
+    """An image panel's artist, empty until the first frame sets its data."""
+    return ax.imshow(
+        np.ma.masked_all(shape),
+        cmap=cmap,
+        origin="lower",
+        extent=extent,
+        interpolation="nearest",  # one raster pixel per image pixel already
+    )
+
+
+def section_axes(
+    ax: Axes, domain_um: tuple[float, ...], title: str, fontsize: float, xlabel: bool = True
+) -> None:
+    """An image panel's axes: the frames' x-y range at equal aspect, in um, and its title."""
+    xmin, xmax, ymin, ymax = domain_um
+    ax.set_xlim(xmin, xmax)
+    ax.set_ylim(ymin, ymax)
+    ax.set_aspect("equal", adjustable="box")
+    if xlabel:
+        ax.set_xlabel("x [um]")
+    ax.set_ylabel("y [um]")
+    ax.set_title(title, fontsize=fontsize)
+
+
 def melt_outline(
     ax: Axes, xs: np.ndarray, ys: np.ndarray, material: np.ndarray, liquid: np.ndarray
 ) -> QuadContourSet | None:
@@ -313,26 +341,15 @@ class Frame2DPainter:
                 strict=True,
             )
         ):
-            im = ax.imshow(
-                np.ma.masked_all(self._shape),
-                cmap=cmap,
-                origin="lower",
-                extent=extent,
-                interpolation="nearest",  # one raster pixel per image pixel already
-            )
+            im = blank_image(ax, cmap, self._shape, extent)
             self._cbars.append(fig.colorbar(im, label=label, **place))
             self._images.append(im)
             # points too isolated to make material (a lone point, one thrown off) stay visible
             self._strays.append(
                 ax.scatter(np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", lw=0)
             )
-            ax.set_xlim(xmin, xmax)
-            ax.set_ylim(ymin, ymax)
-            ax.set_aspect("equal", adjustable="box")
-            if not (self.stacked and i == 0):  # stacked: the lower panel's x label serves both
-                ax.set_xlabel("x [um]")
-            ax.set_ylabel("y [um]")
-            ax.set_title(title, fontsize=10)
+            # stacked: the lower panel's x label serves both
+            section_axes(ax, self.domain_um, title, 10, xlabel=not (self.stacked and i == 0))
         self._axes, self._contour, self._fig = axes, None, fig
 
     def paint(

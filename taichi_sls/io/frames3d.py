@@ -33,11 +33,13 @@ from scipy.ndimage import zoom
 
 from .frames import (
     _finite_range,
+    blank_image,
     checked_domain,
     frame_time_label,
     melt_outline,
     remove_artist,
     save_png,
+    section_axes,
     temperature_cmap,
 )
 from .surface3d import SURFACE_LEVEL, ColourGrid, Surface, colour_grid, surface
@@ -161,20 +163,9 @@ class Frame3DPainter:
             (ax_t, self.cmap, "T [C]", f"temperature at z = {z:.0f} um (cyan: melt)"),
             (ax_l, matplotlib.colormaps["Blues"], "liquid fraction", "liquid fraction"),
         ):
-            im = ax.imshow(
-                np.ma.masked_all((2, 2)),
-                cmap=cmap,
-                origin="lower",
-                extent=(xmin, xmax, ymin, ymax),
-                interpolation="nearest",
-            )
+            im = blank_image(ax, cmap, (2, 2), self.domain_um)
             fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03)
-            ax.set_xlim(xmin, xmax)
-            ax.set_ylim(ymin, ymax)
-            ax.set_aspect("equal", adjustable="box")
-            ax.set_xlabel("x [um]")
-            ax.set_ylabel("y [um]")
-            ax.set_title(title, fontsize=9)
+            section_axes(ax, self.domain_um, title, 9)
             self._images.append(im)
         self._images[1].set_clim(0.0, 1.0)
         # the solver's (x, y up, z) shown as the plot's (x, z, y): up is up
