@@ -31,10 +31,10 @@ from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.ndimage import zoom
 
-from .frames import (
-    _finite_range,
+from .frame_panels import (
     blank_image,
     checked_domain,
+    colour_limits,
     frame_time_label,
     melt_outline,
     remove_artist,
@@ -193,7 +193,7 @@ class Frame3DPainter:
         T, lf = (np.divide(v, c, out=np.full_like(c, np.nan), where=c > 0.0) for v in sums)
         dx, dy = xs[1] - xs[0], ys[1] - ys[0]
         extent = (xs[0] - dx / 2, xs[-1] + dx / 2, ys[0] - dy / 2, ys[-1] + dy / 2)
-        clim = _finite_range(np.asarray(T_points, dtype=float), hi=self.melt_C)
+        clim = colour_limits(np.asarray(T_points, dtype=float), hi=self.melt_C)
         for im, v in zip(self._images, (T, lf), strict=True):
             im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
             im.set_extent(extent)

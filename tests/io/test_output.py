@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
+from taichi_sls.io.frame_panels import frame_time_label
 from taichi_sls.io.frames import (
     MATERIAL_LEVEL,
     Frame2DPainter,
-    frame_time_label,
     material_raster,
 )
 from taichi_sls.io.series import plot_series
