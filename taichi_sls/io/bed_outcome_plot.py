@@ -24,7 +24,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from .contacts_plot import KINDS, contact_kind
-from .frames import MATERIAL_LEVEL, material_raster, point_spacing, save_png
+from .frame_panels import save_png
+from .frames import MATERIAL_LEVEL, material_raster, point_spacing
 
 SOLID_COLOUR = "#c9ced6"  # powder never fully molten: light grey
 MELTED_COLOUR = "#f3c58f"  # powder that was fully molten at some time: light orange

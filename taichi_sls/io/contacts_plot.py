@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .frames import save_png
+from .frame_panels import save_png
 
 # (label, colour) of each contact outcome, in the order the legend lists them
 KINDS = {

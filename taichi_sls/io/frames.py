@@ -1,4 +1,5 @@
-"""Frame images: the material coloured by temperature (melt outlined) and by deformation.
+"""The frame images of a 2D run: the material coloured by temperature (melt outlined) and by
+deformation (io/painter.py: the interface; io/frame_panels.py: what the 3D frames share).
 
 The points are drawn as the material they stand for, rasterised at screen resolution: each
 point spreads its area and its field over a tent a few point spacings wide, and the pixels whose
@@ -12,10 +13,8 @@ hundreds of frames; the axes box is fixed so that the raster is the same in ever
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -26,13 +25,21 @@ matplotlib.use("Agg")  # headless: the solver runs on machines without a display
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.colors import Colormap, ListedColormap
 from matplotlib.figure import Figure
 from scipy.ndimage import correlate1d
 
-from .atomic import atomic_write_bytes
+from .frame_panels import (
+    blank_image,
+    checked_domain,
+    colour_limits,
+    frame_time_label,
+    melt_outline,
+    remove_artist,
+    save_png,
+    section_axes,
+    temperature_cmap,
+)
 
-MELT_LEVEL = 0.5  # liquid fraction drawn as the melt outline
 MATERIAL_LEVEL = 0.5  # area fraction drawn as material: the outline of a regular lattice
 # Half-width of the tent that spreads a point, in point spacings. At 3 the strip of a coalescing
 # pair (its points 2 spacings apart across it) reads 2/3 and is filled, a gap of 3 spacings
@@ -73,21 +80,6 @@ def point_spacing(x: np.ndarray, fallback: float) -> float:
     count = float(np.quantile(counts, 0.75))
     h = math.sqrt(math.pi * r2 / count)
     return h if h > 0.0 else fallback
-
-
-def _finite_range(
-    v: np.ndarray, lo: float | None = None, hi: float | None = None
-) -> tuple[float, float]:
-    """Colour limits spanning the finite values and the anchors; never degenerate."""
-    f = v[np.isfinite(v)]
-    vals = [float(f.min()), float(f.max())] if f.size else []
-    vals += [a for a in (lo, hi) if a is not None]
-    if not vals:
-        return 0.0, 1.0
-    vmin, vmax = min(vals), max(vals)
-    if not vmax > vmin:  # uniform field: Normalize would divide by zero
-        vmin, vmax = vmin - (0.0 if lo is not None else 1.0), vmax + 1.0
-    return vmin, vmax
 
 
 def material_raster(
@@ -160,44 +152,18 @@ def _pixels(
     return on, ij
 
 
-def frame_time_label(t_s: float) -> str:
-    """A frame's title: the time in us below 1 ms (the paper's pulses), then ms, then s (a
-    layer time of seconds reads "t = 10 s", not in millions of us)."""
-    if t_s < 1e-3:
-        return f"t = {t_s * 1e6:.1f} us"
-    if t_s < 1.0:
-        return f"t = {t_s * 1e3:.4g} ms"
-    return f"t = {t_s:.4g} s"
-
-
-def save_png(fig: Figure, path: Path, dpi: int) -> None:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    atomic_write_bytes(path, buf.getvalue())
-
-
 # A scene wider than this (width / height: a powder layer) stacks its two panels, each across
 # the whole frame, rather than squeezing them side by side into strips a few dozen pixels high.
 STACK_ASPECT = 2.0
 STACKED_WIDTH_IN = 13.0  # inches: 1040 px at the default dpi of 80
 STACKED_PANEL_H_IN = (1.5, 5.0)  # a panel's axes height is clamped to this range (inches)
-# The bed's temperature scale: inferno from a quarter up, so that the powder at the bed
-# temperature (the scale's foot) is a clear purple, not the black of inferno's foot, which reads
-# as shadow or void against the white background.
-BED_T_CMAP_FROM = 0.25
 
 
-def temperature_cmap(bed: bool) -> Colormap:
-    """inferno for a pair (today's frames); for a bed inferno from BED_T_CMAP_FROM up."""
-    base = matplotlib.colormaps["inferno"]
-    if not bed:
-        return base
-    return ListedColormap(base(np.linspace(BED_T_CMAP_FROM, 1.0, 256)), name="inferno_bed")
+class Frame2DPainter:
+    """Draws one 2D frame into a reused figure of two panels (temperature, deformation): side
+    by side, or stacked for a scene wider than STACK_ASPECT (io/painter.FramePainter)."""
 
-
-class FramePainter:
-    """Draws one frame into a reused figure of two panels (temperature, deformation): side by
-    side, or stacked for a scene wider than STACK_ASPECT."""
+    dim = 2
 
     def __init__(
         self,
@@ -207,12 +173,16 @@ class FramePainter:
         dpi: int = 80,
         bed: bool = False,
     ) -> None:
-        self.domain_um = domain_um
-        self.melt_C = melt_C
+        self.domain_um = checked_domain(domain_um)
+        self.melt_C = float(melt_C)
+        if deformation not in DEFORM_LABELS:
+            raise ValueError(
+                f"deformation={deformation!r}; allowed: {', '.join(sorted(DEFORM_LABELS))}"
+            )
         self.deformation = deformation
-        self.dpi = dpi  # the raster's pixel is one pixel of the saved image
+        self.dpi = int(dpi)  # the raster's pixel is one pixel of the saved image
         self.bed = bed
-        xmin, xmax, ymin, ymax = domain_um
+        xmin, xmax, ymin, ymax = self.domain_um
         self.stacked = (xmax - xmin) > STACK_ASPECT * (ymax - ymin)
         self._fig: Figure | None = None
 
@@ -276,29 +246,26 @@ class FramePainter:
                 strict=True,
             )
         ):
-            im = ax.imshow(
-                np.ma.masked_all(self._shape),
-                cmap=cmap,
-                origin="lower",
-                extent=extent,
-                interpolation="nearest",  # one raster pixel per image pixel already
-            )
+            im = blank_image(ax, cmap, self._shape, extent)
             self._cbars.append(fig.colorbar(im, label=label, **place))
             self._images.append(im)
             # points too isolated to make material (a lone point, one thrown off) stay visible
             self._strays.append(
                 ax.scatter(np.zeros(0), np.zeros(0), c=np.zeros(0), cmap=cmap, marker="s", lw=0)
             )
-            ax.set_xlim(xmin, xmax)
-            ax.set_ylim(ymin, ymax)
-            ax.set_aspect("equal", adjustable="box")
-            if not (self.stacked and i == 0):  # stacked: the lower panel's x label serves both
-                ax.set_xlabel("x [um]")
-            ax.set_ylabel("y [um]")
-            ax.set_title(title, fontsize=10)
+            # stacked: the lower panel's x label serves both
+            section_axes(ax, self.domain_um, title, 10, xlabel=not (self.stacked and i == 0))
         self._axes, self._contour, self._fig = axes, None, fig
 
-    def draw(self, t_s: float, x: np.ndarray, fields: dict[str, np.ndarray]) -> None:
+    def paint(
+        self, t_s: float, x: np.ndarray, fields: Mapping[str, np.ndarray], png: Path | None
+    ) -> None:
+        """The frame at ``t_s`` into ``png`` (if given); a 2D frame has no surface for the VTU."""
+        if png is not None:
+            self.draw(t_s, x, fields)
+            save_png(self._fig, png, self.dpi)
+
+    def draw(self, t_s: float, x: np.ndarray, fields: Mapping[str, np.ndarray]) -> None:
         if self._fig is None:
             self._setup_figure()
         fallback = (
@@ -312,7 +279,7 @@ class FramePainter:
         )
         material = fraction >= MATERIAL_LEVEL
         # T range always includes melt_C and |u| starts at 0, so colours keep their meaning.
-        limits = (_finite_range(T, hi=self.melt_C), _finite_range(d, lo=0.0))
+        limits = (colour_limits(T, hi=self.melt_C), colour_limits(d, lo=0.0))
         stray = ~_on_material(x, material, (self.domain_um[0], self.domain_um[2]), self._pixel)
         size = max((h * self._pt_per_um) ** 2, MIN_MARKER_PT2)  # the point's own footprint
         for im, sc, v, p, clim in zip(
@@ -324,24 +291,9 @@ class FramePainter:
             sc.set_array(np.asarray(p, dtype=float)[stray])
             sc.set_sizes(np.array([size]))
             sc.set_clim(*clim)
-        if self._contour is not None:
-            with contextlib.suppress(Exception):
-                self._contour.remove()
-            self._contour = None
-        # The melt outline on the same raster, the void counting as solid: the outline closes
-        # along the free surface and, like the material, has no gap along the mid-plane strip.
-        melt = np.where(material, np.nan_to_num(lf_px, nan=0.0), 0.0)
-        if (melt > MELT_LEVEL).any():
-            try:
-                self._contour = self._axes[0].contour(
-                    *self._pixel_centres, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
-                )
-            except Exception:  # noqa: BLE001 -- the outline is decoration; never lose a frame
-                self._contour = None
+        remove_artist(self._contour)
+        self._contour = melt_outline(self._axes[0], *self._pixel_centres, material, lf_px)
         self._fig.suptitle(frame_time_label(t_s))
-
-    def save(self, path: Path, dpi: int) -> None:
-        save_png(self._fig, path, dpi)
 
     def close(self) -> None:
         self._fig = None  # drop the figure; a later draw rebuilds it

@@ -15,7 +15,7 @@ the points seeded in the lattice layer at that section (:func:`section_layer`)."
 
 from __future__ import annotations
 
-import contextlib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,8 +31,18 @@ from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.ndimage import zoom
 
-from .frames import MELT_LEVEL, _finite_range, frame_time_label, save_png, temperature_cmap
-from .surface3d import SURFACE_LEVEL, ColourGrid, Surface
+from .frame_panels import (
+    blank_image,
+    checked_domain,
+    colour_limits,
+    frame_time_label,
+    melt_outline,
+    remove_artist,
+    save_png,
+    section_axes,
+    temperature_cmap,
+)
+from .surface3d import SURFACE_LEVEL, ColourGrid, Surface, colour_grid, surface
 
 # the light: from above (y), in front (-z: the viewer's side) and to the left (-x)
 LIGHT = np.array([-0.4, 1.0, -0.6]) / np.linalg.norm([-0.4, 1.0, -0.6])
@@ -101,7 +111,10 @@ def shade(normals: np.ndarray) -> np.ndarray:
 
 
 class Frame3DPainter:
-    """Draws one 3D frame (section of T, section of the liquid fraction, lit surface)."""
+    """Draws one 3D frame (section of T, section of the liquid fraction, lit surface) into a
+    reused figure (io/painter.FramePainter)."""
+
+    dim = 3
 
     def __init__(
         self,
@@ -109,12 +122,29 @@ class Frame3DPainter:
         view: View3D,
         melt_C: float,
         bed: bool = False,
+        dpi: int = 80,
     ) -> None:
-        self.domain_um = domain_um
+        self.domain_um = checked_domain(domain_um)
         self.view = view
-        self.melt_C = melt_C
+        self.melt_C = float(melt_C)
         self.cmap = temperature_cmap(bed)
+        self.dpi = int(dpi)
         self._fig: Figure | None = None
+
+    def paint(
+        self, t_s: float, x: np.ndarray, fields: Mapping[str, np.ndarray], png: Path | None
+    ) -> Surface:
+        """The frame at ``t_s`` into ``png`` (if given); the colour grid and its surface are
+        computed once, for the picture and for the VTU (the surface returned)."""
+        xmin, xmax, ymin, ymax = self.domain_um
+        read = {k: fields[k] for k in ("T_C", "liquid_fraction")}
+        box = ((xmin, xmax), (ymin, ymax), self.view.z_range_um)
+        grid = colour_grid(x, read, self.view.point_spacing_um, box)
+        surf = surface(grid)
+        if png is not None:
+            self.draw(t_s, grid, surf, fields["T_C"])
+            save_png(self._fig, png, self.dpi)
+        return surf
 
     def _setup(self) -> None:
         xmin, xmax, ymin, ymax = self.domain_um
@@ -133,20 +163,9 @@ class Frame3DPainter:
             (ax_t, self.cmap, "T [C]", f"temperature at z = {z:.0f} um (cyan: melt)"),
             (ax_l, matplotlib.colormaps["Blues"], "liquid fraction", "liquid fraction"),
         ):
-            im = ax.imshow(
-                np.ma.masked_all((2, 2)),
-                cmap=cmap,
-                origin="lower",
-                extent=(xmin, xmax, ymin, ymax),
-                interpolation="nearest",
-            )
+            im = blank_image(ax, cmap, (2, 2), self.domain_um)
             fig.colorbar(im, ax=ax, label=label, fraction=0.046, pad=0.03)
-            ax.set_xlim(xmin, xmax)
-            ax.set_ylim(ymin, ymax)
-            ax.set_aspect("equal", adjustable="box")
-            ax.set_xlabel("x [um]")
-            ax.set_ylabel("y [um]")
-            ax.set_title(title, fontsize=9)
+            section_axes(ax, self.domain_um, title, 9)
             self._images.append(im)
         self._images[1].set_clim(0.0, 1.0)
         # the solver's (x, y up, z) shown as the plot's (x, z, y): up is up
@@ -174,22 +193,15 @@ class Frame3DPainter:
         T, lf = (np.divide(v, c, out=np.full_like(c, np.nan), where=c > 0.0) for v in sums)
         dx, dy = xs[1] - xs[0], ys[1] - ys[0]
         extent = (xs[0] - dx / 2, xs[-1] + dx / 2, ys[0] - dy / 2, ys[-1] + dy / 2)
-        clim = _finite_range(np.asarray(T_points, dtype=float), hi=self.melt_C)
+        clim = colour_limits(np.asarray(T_points, dtype=float), hi=self.melt_C)
         for im, v in zip(self._images, (T, lf), strict=True):
             im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
             im.set_extent(extent)
         self._images[0].set_clim(*clim)
         for artist in (self._contour, self._mesh):
-            if artist is not None:
-                with contextlib.suppress(Exception):
-                    artist.remove()
-        self._contour = self._mesh = None
-        melt = np.where(material, np.nan_to_num(lf, nan=0.0), 0.0)
-        if (melt > MELT_LEVEL).any():
-            with contextlib.suppress(Exception):  # the outline is decoration
-                self._contour = self._ax_t.contour(
-                    xs, ys, melt, levels=[MELT_LEVEL], colors="cyan", linewidths=1.0
-                )
+            remove_artist(artist)
+        self._mesh = None
+        self._contour = melt_outline(self._ax_t, xs, ys, material, lf)
         if len(surf.tris):
             colour = self.cmap(Normalize(*clim)(surf.values["T_C"][surf.tris].mean(axis=1)))
             colour[:, :3] *= shade(surf.normals())[:, None]
@@ -201,9 +213,6 @@ class Frame3DPainter:
             )
             self._ax_s.add_collection3d(self._mesh)
         self._fig.suptitle(frame_time_label(t_s))
-
-    def save(self, path: Path, dpi: int) -> None:
-        save_png(self._fig, path, dpi)
 
     def close(self) -> None:
         self._fig = None

@@ -19,7 +19,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from .frames import MATERIAL_LEVEL, material_raster, point_spacing, save_png
+from .frame_panels import save_png
+from .frames import MATERIAL_LEVEL, material_raster, point_spacing
 from .series import read_series
 
 FINAL_COLOUR = "#4a7fb5"  # filled final material

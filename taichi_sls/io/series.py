@@ -20,7 +20,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from .atomic import atomic_write_text
-from .frames import save_png
+from .frame_panels import save_png
 
 SERIES_LABELS = {
     "contact_line_um": "contact line [um]",

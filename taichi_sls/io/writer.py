@@ -12,12 +12,11 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_write_text
-from .frames import DEFORM_LABELS, FramePainter
-from .frames3d import Frame3DPainter, View3D
+from .frames import DEFORM_LABELS
 from .gif import write_gif
+from .painter import FRAME_FIELDS, FramePainter
 from .series import BED_PANELS, BED_PANELS_PER_ROW, MONITORED, SeriesWriter, plot_series
 from .summary import write_summary
-from .surface3d import colour_grid, surface
 from .vtu import VtuWriter
 
 # the drawn deformation in a VTU written without the full point data: named for what it is
@@ -28,48 +27,34 @@ VTU_DEFORM_NAMES = {
 
 
 class OutputWriter:
-    """Writes everything a run produces into ``out_dir``; see the module docstring."""
+    """Writes everything a run produces into ``out_dir``; see the module docstring. The frames'
+    pictures are ``painter``'s (io/painter.frame_painter picks it for a case)."""
 
     def __init__(
         self,
         out_dir: Path,
         *,
-        domain_um: tuple[float, float, float, float],
-        melt_C: float,
+        painter: FramePainter,
         png: bool = True,
         gif: bool = True,
         vtu: bool = False,
-        dpi: int = 80,
         deformation: str = "displacement",
         bed: bool = False,
-        view3d: View3D | None = None,
     ) -> None:
         if deformation not in DEFORM_LABELS:
             raise ValueError(
                 f"deformation={deformation!r}; allowed: {', '.join(sorted(DEFORM_LABELS))}"
             )
-        xmin, xmax, ymin, ymax = (float(v) for v in domain_um)
-        if not (xmax > xmin and ymax > ymin):
-            raise ValueError(f"domain_um={domain_um!r} must be (xmin, xmax, ymin, ymax), min<max")
         self.out_dir = Path(out_dir)
         self.png, self.gif, self.vtu = png, gif, vtu
-        self.deformation = deformation
-        self.bed = bed  # a powder layer: its own series (BED_PANELS) and the bed's frame colours
-        self.dpi = int(dpi)
+        self.deformation = deformation  # the drawn one, and the VTU's without full point data
+        self.bed = bed  # a powder layer: its own series (BED_PANELS)
         self.frames_written = 0
         self.out_dir.mkdir(parents=True, exist_ok=True)
         (self.out_dir / "frames").mkdir(exist_ok=True)
         self._png_paths: dict[int, Path] = {}
         self.series = SeriesWriter(self.out_dir / "timeseries.csv")
-        self.view3d = view3d  # a 3D run: points (N, 3), frames of io/frames3d.py
-        self._painter: FramePainter | Frame3DPainter
-        if view3d is None:
-            self._painter = FramePainter(
-                (xmin, xmax, ymin, ymax), float(melt_C), deformation, dpi=self.dpi, bed=bed
-            )
-        else:
-            self._painter = Frame3DPainter((xmin, xmax, ymin, ymax), view3d, float(melt_C), bed)
-        self.domain_um = (xmin, xmax, ymin, ymax)
+        self._painter = painter
         self._vtu = VtuWriter(self.out_dir)
 
     # ----------------------------------------------------------------- simple files
@@ -123,32 +108,25 @@ class OutputWriter:
         if not (self.png or self.vtu):  # nothing to draw
             self.frames_written += 1
             return
-        x = np.asarray(x_um, dtype=float).reshape(-1, 2 if self.view3d is None else 3)
+        x = np.asarray(x_um, dtype=float).reshape(-1, self._painter.dim)
         fields = {
-            "T_C": np.asarray(T_C, dtype=float).ravel(),
-            "deform": np.asarray(deform, dtype=float).ravel(),
-            "liquid_fraction": np.asarray(liquid_fraction, dtype=float).ravel(),
+            name: np.asarray(v, dtype=float).ravel()
+            for name, v in zip(FRAME_FIELDS, (T_C, deform, liquid_fraction), strict=True)
         }
         for name, v in fields.items():
             if v.shape != (len(x),):
                 raise ValueError(f"frame {index}: {name} has {v.size} values for {len(x)} points")
-        index = int(index)
-        if self.view3d is not None:
-            self._frame_3d(index, float(t_s), x, fields, point_data)
-            self.frames_written += 1
-            return
-        if self.png:
-            self._painter.draw(t_s, x, fields)
-            self._save_png(index)
+        index, t_s = int(index), float(t_s)
+        png = self.out_dir / "frames" / f"frame_{index:04d}.png" if self.png else None
+        surf = self._painter.paint(t_s, x, fields, png)
+        if png is not None:
+            self._png_paths[index] = png
         if self.vtu:
             read = {k: fields[k] for k in ("T_C", "liquid_fraction")}
-            self._vtu.write(index, float(t_s), x, {**read, **self._vtu_extra(fields, point_data)})
+            self._vtu.write(index, t_s, x, {**read, **self._vtu_extra(fields, point_data)})
+            if surf is not None:  # the material's surface, beside the points (3D)
+                self._vtu.write_surface(index, t_s, surf.verts, surf.tris, surf.values)
         self.frames_written += 1
-
-    def _save_png(self, index: int) -> None:
-        path = self.out_dir / "frames" / f"frame_{index:04d}.png"
-        self._painter.save(path, self.dpi)
-        self._png_paths[index] = path
 
     def _vtu_extra(
         self, fields: dict[str, np.ndarray], point_data: Mapping[str, np.ndarray] | None
@@ -157,28 +135,6 @@ class OutputWriter:
         if point_data is not None:
             return point_data
         return {VTU_DEFORM_NAMES[self.deformation]: fields["deform"]}
-
-    def _frame_3d(
-        self,
-        index: int,
-        t_s: float,
-        x: np.ndarray,
-        fields: dict[str, np.ndarray],
-        point_data: Mapping[str, np.ndarray] | None,
-    ) -> None:
-        """A 3D frame: the colour grid and its surface once, for the PNG and the VTU."""
-        v = self.view3d
-        xmin, xmax, ymin, ymax = self.domain_um
-        read = {k: fields[k] for k in ("T_C", "liquid_fraction")}
-        grid = colour_grid(x, read, v.point_spacing_um, ((xmin, xmax), (ymin, ymax), v.z_range_um))
-        surf = surface(grid)
-        if self.png:
-            assert isinstance(self._painter, Frame3DPainter)
-            self._painter.draw(t_s, grid, surf, fields["T_C"])
-            self._save_png(index)
-        if self.vtu:
-            self._vtu.write(index, t_s, x, {**read, **self._vtu_extra(fields, point_data)})
-            self._vtu.write_surface(index, t_s, surf.verts, surf.tris, surf.values)
 
     # ----------------------------------------------------------------- end of run
 

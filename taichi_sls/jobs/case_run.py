@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..config import Case, case_to_toml
-from ..io.frames3d import view_3d
+from ..io.painter import frame_painter
 from ..io.writer import OutputWriter
 from ..solver import compile_clock
 from ..solver.guard import SimulationError
@@ -125,23 +125,15 @@ def unheated_baseline(case: Case) -> float | None:
 def output_writer(case: Case, out_dir: Path) -> OutputWriter:
     """The run's output folder, with the case as given (case.toml) and as resolved
     (resolved.toml: the bed's bodies, the fitted domain, the laser depths)."""
-    o, g = case.output, case.grid
+    o, bed = case.output, is_bed(case)
     writer = OutputWriter(
         out_dir,
-        domain_um=(
-            -g.ghost_cells * g.spacing_um,
-            case.domain.width_um + g.ghost_cells * g.spacing_um,
-            -g.ghost_cells * g.spacing_um,
-            case.domain.height_um,
-        ),
-        melt_C=min(m.melt_C for m in case.materials.values()),
+        painter=frame_painter(case, bed),
         png=o.png,
         gif=o.gif,
         vtu=o.vtu,
-        dpi=o.dpi,
         deformation=o.deformation,
-        bed=is_bed(case),
-        view3d=view_3d(case) if case.domain.dim == 3 else None,
+        bed=bed,
     )
     writer.write_case(case_to_toml(getattr(case, "given", None) or case))
     writer.write_case(case_to_toml(case), "resolved.toml")

@@ -16,7 +16,7 @@ import pytest
 from matplotlib.colors import to_rgb
 
 from taichi_sls.io.bed_outcome_plot import MELTED_COLOUR, NECK_HISTS, bed_outcome_figure
-from taichi_sls.io.frames import STACK_ASPECT, FramePainter
+from taichi_sls.io.frames import STACK_ASPECT, Frame2DPainter
 from taichi_sls.io.series import (
     BED_PANELS,
     BED_PANELS_PER_ROW,
@@ -160,11 +160,13 @@ def test_the_bed_panels_cover_the_beds_series() -> None:
 def test_a_bed_writer_draws_the_bed_series_and_a_pair_writer_todays(tmp_path: Path) -> None:
     """timeseries.png of a bed: two rows of three panels; of a pair: contact line and peak
     temperature side by side (1 row of 2 panels of 4.2 x 3.2 in at 100 dpi), as before."""
-    bed = OutputWriter(tmp_path / "bed", domain_um=BED_DOMAIN, melt_C=MELT_C, gif=False, bed=True)
+    bed_painter = Frame2DPainter(BED_DOMAIN, MELT_C, "displacement", bed=True)
+    bed = OutputWriter(tmp_path / "bed", painter=bed_painter, gif=False, bed=True)
     write_bed_series(bed.out_dir / "timeseries.csv")
     bed.series.resume()
     bed.finish({"beam off": 1e-4})
-    pair = OutputWriter(tmp_path / "pair", domain_um=PAIR_DOMAIN, melt_C=MELT_C, gif=False)
+    pair_painter = Frame2DPainter(PAIR_DOMAIN, MELT_C, "displacement")
+    pair = OutputWriter(tmp_path / "pair", painter=pair_painter, gif=False)
     write_bed_series(pair.out_dir / "timeseries.csv")
     pair.series.resume()
     pair.finish()
@@ -174,8 +176,8 @@ def test_a_bed_writer_draws_the_bed_series_and_a_pair_writer_todays(tmp_path: Pa
     assert [ax.get_ylabel() for ax in fig.axes] == [SERIES_LABELS[c] for c in MONITORED]
 
 
-def _draw(domain: tuple[float, ...], bed: bool, x: np.ndarray, T: np.ndarray) -> FramePainter:
-    painter = FramePainter(domain, MELT_C, "displacement", dpi=80, bed=bed)
+def _draw(domain: tuple[float, ...], bed: bool, x: np.ndarray, T: np.ndarray) -> Frame2DPainter:
+    painter = Frame2DPainter(domain, MELT_C, "displacement", dpi=80, bed=bed)
     lf = np.clip((T - MELT_C) / 5.0, 0.0, 1.0)
     painter.draw(1e-5, x, {"T_C": T, "deform": np.zeros(len(x)), "liquid_fraction": lf})
     painter._fig.canvas.draw()

@@ -9,7 +9,9 @@ import numpy as np
 from helpers import deep_update, make_case
 
 import taichi_sls as sls
-from taichi_sls.io.frames3d import LIGHT, View3D, shade, view_3d
+from taichi_sls.io.frames import Frame2DPainter
+from taichi_sls.io.frames3d import LIGHT, Frame3DPainter, View3D, shade, view_3d
+from taichi_sls.io.painter import frame_painter
 from taichi_sls.io.surface3d import colour_grid, surface
 from taichi_sls.io.writer import OutputWriter
 from taichi_sls.jobs.case_run import run_case
@@ -104,12 +106,36 @@ def test_section_is_at_the_track_of_a_laser_along_x_else_mid_depth():
     assert v.z_range_um[1] - v.z_range_um[0] > 32.0  # the ghost layer in z as in x
 
 
+def test_the_frame_painter_is_picked_by_the_case_dimension():
+    """io/painter.frame_painter: a 3D case gets the 3D frames at its view, a 2D case the 2D
+    frames with its deformation and dpi; both over the domain and its ghost layer, to the top."""
+    sphere = {
+        "domain": {"dim": 3, "width_um": 40.0, "height_um": 40.0, "depth_um": 32.0},
+        "bodies": [{"shape": "disc", "center_um": [20.0, 20.0, 16.0], "radius_um": 10.0}],
+        "physics": {"surface_tension": False},
+    }
+    p3 = frame_painter(make_case(sphere), bed=True)
+    assert isinstance(p3, Frame3DPainter) and p3.dim == 3
+    assert p3.view == view_3d(make_case(sphere)) and p3.domain_um == (-2.0, 42.0, -2.0, 40.0)
+    disc = {
+        "domain": {"width_um": 40.0, "height_um": 30.0},
+        "bodies": [{"shape": "disc", "center_um": [20.0, 15.0], "radius_um": 8.0}],
+        "output": {"deformation": "plastic_strain", "dpi": 50},
+    }
+    p2 = frame_painter(make_case(disc))
+    assert isinstance(p2, Frame2DPainter) and p2.dim == 2
+    assert (p2.deformation, p2.dpi, p2.domain_um) == (
+        "plastic_strain",
+        50,
+        (-2.0, 42.0, -2.0, 30.0),
+    )
+
+
 def test_3d_frames_of_no_point_one_point_and_flung_points_are_written(tmp_path):
     """A failed run's last frame may hold points flung off the grid or NaN: left out of the
     colour grid, the frame and the VTU are still written (the points VTU keeps them all)."""
-    w = OutputWriter(
-        tmp_path, domain_um=(0, 20, 0, 20), melt_C=175.0, vtu=True, view3d=View3D((0, 20), 1, 10)
-    )
+    painter = Frame3DPainter((0, 20, 0, 20), View3D((0, 20), 1, 10), 175.0)
+    w = OutputWriter(tmp_path, painter=painter, vtu=True)
     states = [
         np.zeros((0, 3)),
         np.array([[5.0, 5.0, 5.0]]),

@@ -14,7 +14,12 @@ import numpy as np
 import pytest
 
 from taichi_sls.io.atomic import atomic_write_bytes, atomic_write_text
-from taichi_sls.io.frames import MATERIAL_LEVEL, frame_time_label, material_raster
+from taichi_sls.io.frame_panels import frame_time_label
+from taichi_sls.io.frames import (
+    MATERIAL_LEVEL,
+    Frame2DPainter,
+    material_raster,
+)
 from taichi_sls.io.series import plot_series
 from taichi_sls.io.vtu import VtuWriter, point_data, stress_invariants
 from taichi_sls.io.writer import OutputWriter
@@ -41,9 +46,14 @@ def synthetic(step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
     return x, T, u, lf
 
 
+def disc_painter() -> Frame2DPainter:
+    """The 2D frames of the synthetic discs."""
+    return Frame2DPainter(DOMAIN, MELT_C, "displacement")
+
+
 @pytest.fixture
 def writer(tmp_path: Path) -> OutputWriter:
-    return OutputWriter(tmp_path / "run", domain_um=DOMAIN, melt_C=MELT_C, vtu=True)
+    return OutputWriter(tmp_path / "run", painter=disc_painter(), vtu=True)
 
 
 def test_full_run(writer: OutputWriter) -> None:
@@ -129,7 +139,10 @@ def test_atomic_write_failure_keeps_old(tmp_path: Path) -> None:
 )
 def test_degenerate_frames(tmp_path: Path, x: np.ndarray, T: np.ndarray) -> None:
     w = OutputWriter(
-        tmp_path, domain_um=DOMAIN, melt_C=MELT_C, vtu=True, deformation="plastic_strain"
+        tmp_path,
+        painter=Frame2DPainter(DOMAIN, MELT_C, "plastic_strain"),
+        vtu=True,
+        deformation="plastic_strain",
     )
     lf = (T > MELT_C).astype(float)
     w.frame(0, 0.0, x, T, np.zeros(len(x)), lf)
@@ -149,11 +162,13 @@ def test_mismatched_lengths_raise(writer: OutputWriter) -> None:
 
 def test_bad_deformation(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="deformation"):
-        OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, deformation="strain")
+        OutputWriter(tmp_path, painter=disc_painter(), deformation="strain")
+    with pytest.raises(ValueError, match="deformation"):
+        Frame2DPainter(DOMAIN, MELT_C, "strain")
 
 
 def test_finish_without_rows_or_frames(tmp_path: Path) -> None:
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    w = OutputWriter(tmp_path, painter=disc_painter())
     w.finish()  # nothing written: must not raise
     w.row({"t_s": 0.0, "T_max_C": 25.0})
     w.finish()  # one row: plot skipped
@@ -162,7 +177,7 @@ def test_finish_without_rows_or_frames(tmp_path: Path) -> None:
 
 
 def test_row_columns_and_values(tmp_path: Path) -> None:
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    w = OutputWriter(tmp_path, painter=disc_painter())
     w.row({"t_s": 0.1, "a": 1, "b": float("inf")})
     w.row({"b": math.pi, "t_s": 0.2, "c": np.float32(0.5)})  # new key appended, order fixed
     with (tmp_path / "timeseries.csv").open(newline="") as f:
@@ -175,7 +190,7 @@ def test_row_columns_and_values(tmp_path: Path) -> None:
 
 
 def test_plot_series_missing_column(tmp_path: Path) -> None:
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C)
+    w = OutputWriter(tmp_path, painter=disc_painter())
     for i in range(4):
         w.row({"t_s": i * 1e-6, "contact_line_um": float(i)})
     png = tmp_path / "p.png"
@@ -187,7 +202,7 @@ def test_plot_series_missing_column(tmp_path: Path) -> None:
 def test_gif_size_limit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from taichi_sls.io import gif as output
 
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, dpi=40)
+    w = OutputWriter(tmp_path, painter=Frame2DPainter(DOMAIN, MELT_C, "displacement", dpi=40))
     for i in range(12):
         x, T, u, lf = synthetic(i % 4)
         w.frame(i, i * 1e-6, x + (i % 7, 0.0), T, u, lf)
@@ -288,7 +303,7 @@ VTU_FIELDS = {  # name: components in the file
 def test_vtu_point_data_is_complete_and_valid(tmp_path: Path) -> None:
     x, T, u, lf = synthetic(1)
     extra = solver_point_data(x)
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, png=False, gif=False, vtu=True)
+    w = OutputWriter(tmp_path, painter=disc_painter(), png=False, gif=False, vtu=True)
     w.frame(0, 0.0, x, T, u, lf, extra)
     path = tmp_path / "vtu" / "points_0000.vtu"
 
@@ -336,7 +351,7 @@ def test_point_data_of_no_points(tmp_path: Path) -> None:
     data = solver_point_data(np.zeros((0, 2)))
     assert set(data) == set(VTU_FIELDS) - {"T_C", "liquid_fraction"}
     assert data["velocity_m_s"].shape == (0, 3) and data["von_mises_Pa"].shape == (0,)
-    w = OutputWriter(tmp_path, domain_um=DOMAIN, melt_C=MELT_C, png=False, gif=False, vtu=True)
+    w = OutputWriter(tmp_path, painter=disc_painter(), png=False, gif=False, vtu=True)
     w.frame(0, 0.0, np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0), data)
     names = {
         a.get("Name") for a in ET.parse(tmp_path / "vtu" / "points_0000.vtu").iter("DataArray")
