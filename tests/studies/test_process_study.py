@@ -202,6 +202,8 @@ TINY = [
 ]
 
 
+# slow: four runs on Dask (~25 s); the sweep runner's own runs stay in default (test_sweep.py)
+@pytest.mark.slow
 def test_a_tiny_energy_sweep_runs_and_draws_beside_the_measured_points(tmp_path):
     sweep = energy_sweep(BASE, points=[(10.0, 8.0, 80.0), (25.0, 8.0, 80.0)], reduction=TINY)
     out = tmp_path / "process"

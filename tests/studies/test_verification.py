@@ -128,6 +128,8 @@ def test_laser_spot_on_a_3d_half_space():
     assert r.errors["surface_max"] < 0.05
 
 
+# slow: a verification study (~15 s); the inviscid period row stays in default
+@pytest.mark.slow
 def test_viscous_decay_of_a_disc_mode_at_coarse_resolution():
     """R/h = 10: the fitted decay rate of the n = 2 mode against n gamma / (2 eta_N R) (Stokes
     flow of a disc). Measured with the surface-energy force and APIC -16.5 %; -2.7 % at
