@@ -115,8 +115,6 @@ def _fold_node(
         _fold_scalar(nd.mass, I, J, twice)
         _fold_vector(nd.momentum, I, J, d, twice)
         _fold_vector(nd.force, I, J, d, twice)
-        if ti.static(st.cfg.surface and st.cfg.se.volume_colour):
-            _fold_scalar(nd.volume, I, J, twice)
         if ti.static(st.cfg.thermal):
             if heat:
                 _fold_scalar(nd.heat_capacity, I, J, twice)

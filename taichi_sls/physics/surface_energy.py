@@ -4,7 +4,7 @@
 The surface energy of the bodies is gamma times the length of their outline. On the grid:
 
 1. **Colour** c_i = m_i / (rho V_c) from the node mass of the P2G (``surface_energy_colour =
-   "mass"``), or c_i = sum_p V_p N_i(x_p) / V_c (``"volume"``). Every point adds to it, whatever
+   "mass"``). Every point adds to it, whatever
    its body: touching bodies share one colour field and so one outline, and they merge. With
    ``surface_energy_colour_filter`` the contoured colour is c after one [1 2 1]/4 pass along x
    and y: a pair whose mid-plane lies on a node line (the paper's) otherwise keeps a one-cell
@@ -63,23 +63,9 @@ GAUSS = {
 
 
 @ti.func
-def scatter_volume(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, base, w, dw):
-    """Volume colour: V_p N_i(x_p) onto the 3x3 nodes of point p (in the P2G loop)."""
-    Vp = pt.volume0[p] * pt.J[p]
-    for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
-        N, gN = node_weight(w, dw, o)
-        scatter_add(cfg, nd.volume, base + o, N * Vp)
-
-
-@ti.func
 def raw_colour(cfg: ti.template(), nd: ti.template(), I):
     """c_i: the fraction of node i's cell that material fills."""
-    c = 0.0
-    if ti.static(cfg.se.volume_colour):
-        c = nd.volume[I] / cfg.cell_volume
-    else:
-        c = nd.mass[I] / (cfg.rho_ref * cfg.cell_volume)
-    return c
+    return nd.mass[I] / (cfg.rho_ref * cfg.cell_volume)
 
 
 @ti.func

@@ -112,7 +112,6 @@ NODE_MEMBERS = {
     "scratch": "scalar",
     "flags": "index",
     "mass_gradient": "vector",
-    "volume": "scalar",
     "colour": "scalar",
     "surface_force": "vector",
 }
@@ -120,7 +119,7 @@ NODE_MEMBERS = {
 
 # the node members the host ever copies (the level-set fill, checkpoints, the neck measures):
 # the nodes' copy kernels range over these alone (solver/struct_copy.py)
-NODE_COPIES = ("phi_raw", "phi", "phi_smooth", "kappa", "flags", "colour", "mass", "volume")
+NODE_COPIES = ("phi_raw", "phi", "phi_smooth", "kappa", "flags", "colour", "mass")
 
 
 def struct_type(members: dict[str, str], dim: int):

@@ -16,7 +16,7 @@ from .neck_section import equivalent_radii, filtered_colour, neck_section, pair_
 # what the host reads of the points and of the nodes, each copied by one kernel (a member's
 # own to_numpy is a kernel of its own, compiled in every process: docs/record/compile.md)
 HOST_POINT_MEMBERS = ("x", "x0", "v", "mass", "volume0", "J", "time_molten")
-HOST_NODE_MEMBERS = ("phi", "colour", "mass", "volume")
+HOST_NODE_MEMBERS = ("phi", "colour", "mass")
 
 
 def point_arrays(st: State, keys: tuple[str, ...] = HOST_POINT_MEMBERS) -> dict[str, np.ndarray]:
@@ -93,11 +93,9 @@ class Necks:
 
     def raw_colour(self) -> np.ndarray:
         """The colour c_i of the current points before any filter: the cell fraction that
-        material fills, from the node mass (or volume, as the case's force takes it)."""
-        self.colour()  # the grid's mass and volume of the current points
+        material fills, from the node mass."""
+        self.colour()  # the grid's mass of the current points
         cfg, nd = self.state.cfg, self.node_arrays()
-        if cfg.se.volume_colour:
-            return nd["volume"] / cfg.cell_volume
         return nd["mass"] / (cfg.rho_ref * cfg.cell_volume)
 
     def material_field(self, measure: str, section: str) -> np.ndarray:
@@ -161,11 +159,8 @@ class Necks:
 
     def colour_weights(self) -> np.ndarray:
         """Each point's share of the colour the force contours, per node of its stencil's
-        unit weight: m / (rho V_cell) for the mass colour, V0 J / V_cell for the volume one."""
+        unit weight: m / (rho V_cell)."""
         cfg = self.state.cfg
-        if cfg.se.volume_colour:
-            pt = point_arrays(self.state, ("volume0", "J"))
-            return pt["volume0"] * pt["J"] / cfg.cell_volume
         return self.mass / (cfg.rho_ref * cfg.cell_volume)
 
     def pair_necks_m(self) -> list[float]:

@@ -88,8 +88,6 @@ def periodic_fold(st: ti.template(), heat: ti.template(), geom: ti.template()):
             _fold(st.cfg, nd.mass, i, j, k, True)
             _fold(st.cfg, nd.momentum, i, j, k, True)
             _fold(st.cfg, nd.force, i, j, k, False)
-            if ti.static(_energy(st.cfg) and st.cfg.se.volume_colour):
-                _fold(st.cfg, nd.volume, i, j, k, True)
             if ti.static(st.cfg.thermal):
                 if heat:
                     _fold(st.cfg, nd.heat_capacity, i, j, k, True)

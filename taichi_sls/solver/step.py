@@ -45,7 +45,7 @@ from ..physics.mechanics import (
 )
 from ..physics.mirror import fold_after_p2g, fold_before_update
 from ..physics.small_matrix import ZERO_VECTOR
-from ..physics.surface_energy import scatter_volume, surface_energy_force
+from ..physics.surface_energy import surface_energy_force
 from ..physics.thermal import (
     counts_molten,
     g2p_heat,
@@ -106,8 +106,6 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
         if ti.static(_csf(st)):
             if geom:
                 nd.phi_raw[I] = st.cfg.phi_cap
-        if ti.static(_energy(st) and st.cfg.se.volume_colour):
-            nd.volume[I] = 0.0
 
 
 def _csf(st) -> bool:
@@ -130,8 +128,6 @@ def _p2g_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template(
     if ti.static(_csf(st)):
         if geom:
             scatter_level_set(st.cfg, pt, nd, p, base)
-    if ti.static(_energy(st) and st.cfg.se.volume_colour):
-        scatter_volume(st.cfg, pt, nd, p, base, w, dw)
 
 
 @ti.func

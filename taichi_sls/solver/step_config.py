@@ -46,7 +46,6 @@ class SurfaceEnergyConfig:
     gauss_points: int
     floor_mass: float  # kg per depth
     spread: bool  # hand a light node's rest to its neighbours (else clip)
-    volume_colour: bool
     filter: bool
 
 
@@ -291,7 +290,6 @@ def step_config(
             gauss_points=st.surface_energy_gauss_points,
             floor_mass=floor,
             spread=st.surface_energy_floor_mode == "spread" and floor > 0.0,
-            volume_colour=st.surface_energy_colour == "volume",
             filter=st.surface_energy_colour_filter,
         ),
         gamma_ramp_s=st.ramp_s,
