@@ -131,34 +131,34 @@ def test_3d_capillary_stiffness_is_the_surface_laplacian():
     """The semi-implicit stiffness on the triangles (physics/stiffness.py, triangle_tangent):
     symmetric, each row summing to zero (a uniform velocity does not stretch the surface), and
     under the dilation v = x - x_c, v^T K v = 2 A scale (tr(I - n n^T) = 2), A the area whose
-    virtual work the force does: -sum f . v / gamma, to round-off. The implicit integrators
-    are 2D only so far (config/dim.py); this is the matrix they will assemble. Slow: its
-    kernel's 27 x 27 node pairs compile for about a minute."""
+    virtual work the force does: -sum f . v / gamma, to round-off. The stiffness is stored as
+    scalar rows (one value per node pair, the same on each velocity component), as the implicit
+    step assembles it. Slow: its kernel's 27 x 27 node pairs take long to compile."""
     from taichi_sls.physics.stiffness import REACH, WIDTH, capillary_tangent
 
     case, sim, f, X = _sphere(4, {"surface_energy_mass_floor": 0.0})
     st = sim.state
     gamma = case.materials["fluid"].surface_tension_N_m
-    K = ti.field(float, f.shape[:3] + (WIDTH,) * 3 + (3, 3))
+    K = ti.field(float, f.shape[:3] + (WIDTH,) * 3)  # scalar rows: the block is K_ij I
 
     @ti.kernel
     def assemble(scale: float):
         capillary_tangent(st.cfg, st.box, st.nodes, K, scale)
 
     assemble(1.0)
-    k = K.to_numpy()  # K[i, d] = K_{i, i + d - REACH}, (3, 3) each
+    k = K.to_numpy()  # K[i, d] = K_{i, i + d - REACH}, the same on each component
     xc = st.points.x.to_numpy().mean(axis=0)
     V = X - xc
     pad = ((REACH, REACH),) * 3
     Vp = np.pad(V, pad + ((0, 0),))
-    kp = np.pad(k, pad + ((0, 0),) * 5)
+    kp = np.pad(k, pad + ((0, 0),) * 3)
     n = V.shape[:3]
     Kv, asym, scale = np.zeros_like(V), 0.0, np.abs(k).max()
     for o in np.ndindex(WIDTH, WIDTH, WIDTH):
         at = tuple(slice(o[a], o[a] + n[a]) for a in range(3))  # the nodes i + d, padded
-        Kv += np.einsum("...ab,...b->...a", k[:, :, :, o[0], o[1], o[2]], Vp[at])
+        Kv += k[:, :, :, o[0], o[1], o[2], None] * Vp[at]
         back = kp[at + tuple(WIDTH - 1 - np.array(o))]  # K_{i + d, i}
-        asym = max(asym, np.abs(k[:, :, :, o[0], o[1], o[2]] - back.swapaxes(-1, -2)).max())
+        asym = max(asym, np.abs(k[:, :, :, o[0], o[1], o[2]] - back).max())
     quad = float((V * Kv).sum())
     rows = k.sum(axis=(3, 4, 5))
     assert np.abs(rows).max() < 1e-12 * scale
