@@ -24,7 +24,7 @@ from .layer_file import read_layer
 from .model import Model, Pair
 from .packing import packing_fractions
 
-MAX_PARTICLES = 20_000  # the generator runs in 10 s (2D) to a minute (3D) at this count
+MAX_PARTICLES = 20_000  # bounds the generator's time, which grows with the count
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ placed; every contact is a tangency exact to round-off.
 
 Lateral boundaries: ``"walls"`` (planes at the ends of the x and z ranges, as a case's domain
 has) or ``"periodic"`` (in x and z: no wall layers, the bulk packing a wide bed has inside).
-Lengths in any one unit. Pure numpy; 2000 spheres take a few seconds.
+Lengths in any one unit. Pure numpy (no kernel to compile).
 """
 
 from __future__ import annotations

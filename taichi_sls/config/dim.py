@@ -101,7 +101,7 @@ def _form(dim: int) -> str:
 
 def _refuse_in_3d(case: Any) -> None:
     """Each feature the 3D solver lacks, refused by its key (the first one met)."""
-    not_yet = "not built in 3D yet (issue #39)"
+    not_yet = "not built in 3D yet"
     ph, st = case.physics, case.surface_tension
     if ph.surface_tension and ph.mechanics and st.method == "csf":
         raise CaseError(

@@ -159,16 +159,16 @@ class Time(Model):
         ge=1,
         description='implicit, linear_solver = "auto": the largest direct solve, in unknowns; '
         "unset: 200000 in 2D, 40000 in 3D (a 3D row holds up to 375 entries, not 75: the "
-        "Cholesky factor fills faster, and AMG-CG solves as fast near 35k unknowns; "
+        "Cholesky factor fills faster, and AMG-CG catches up with it at fewer unknowns; "
         "docs/record/implicit.md)",
     )
     implicit_rows: Literal["auto", "dense", "blocks"] = Field(
         "auto",
         description="implicit, 3D: how the step stores each grid node's matrix rows (10 kB a "
         "node): dense over the grid (the fastest to assemble), or by blocks of 4 x 4 x 4 nodes "
-        "allocated where the step writes (the nodes near material: a third of the memory for "
-        "a pair in its box, some 20 % more assembly time; docs/record/implicit.md); auto: blocks "
-        "where the dense rows would pass 1 GiB. 2D: always dense",
+        "allocated where the step writes (the nodes near material: less memory where material "
+        "fills little of the box, somewhat slower to assemble; docs/record/implicit.md); auto: "
+        "blocks where the dense rows would pass 1 GiB. 2D: always dense",
     )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
         "auto",
@@ -296,8 +296,8 @@ class Solver(Model):
     )
     optimize: bool = Field(
         False,
-        description="Taichi's advanced optimisation: ~1.5x faster steps after a ~100 s "
-        "one-off compile (cached on disk); false compiles in ~5-10 s",
+        description="Taichi's advanced optimisation: faster steps after a much longer one-off "
+        "compile (cached on disk; docs/record/compile.md)",
     )
     fast_math: bool = Field(
         True,

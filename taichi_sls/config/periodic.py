@@ -1,4 +1,4 @@
-"""A periodic depth and the cylinder body (issue #39): ``boundary.front`` and ``boundary.back``
+"""A periodic depth and the cylinder body: ``boundary.front`` and ``boundary.back``
 with ``mechanical = "periodic"`` wrap z with the period ``domain.depth_um`` (solver/periodic.py),
 a ``shape = "cylinder"`` body is a disc extruded along z across the whole depth, and a
 ``shape = "prism"`` body a polygon's outline extruded so. All are 3D only; each bad combination

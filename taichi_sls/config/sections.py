@@ -48,7 +48,7 @@ class Domain(Model):
         2,
         description="2: a plane section, every extensive output per unit depth (energies in "
         "J/m, the _J_per_m columns); 3: a box width x height x depth, the same outputs in J "
-        "(timeseries.csv's columns end in _J); y is up in both. 3D (issue #39) runs spheres "
+        "(timeseries.csv's columns end in _J); y is up in both. 3D runs spheres "
         "([[bodies]] discs with [x, y, z] centres), cylinders and boxes; what it lacks is "
         "refused by its key (docs/limitations.md)",
     )
@@ -326,8 +326,8 @@ class Laser(Model):
     )
     depth_sign: Literal["decay"] = Field(
         "decay",
-        description="decay: exp(-(y_l - y)/eta) (docs/model.md); the printed exp(+(y_l - y)/eta) "
-        '("paper"), which grows with depth, is no longer offered',
+        description="decay: exp(-(y_l - y)/eta) (docs/model.md); the printed exp(+(y_l - y)/eta), "
+        "which grows with depth, is not offered",
     )
 
     def track_windows_along_s(self) -> list[tuple[float, float]]:

@@ -31,7 +31,7 @@ class SurfaceTension(Model):
     surface_energy_colour: Literal["mass"] = Field(
         "mass",
         description="surface_energy: colour from the node mass m_i / (rho V_c) (rho of the first "
-        "body's material); the point volumes' sum V_p N_i / V_c (\"volume\") is no longer offered",
+        "body's material); the point volumes' sum V_p N_i / V_c is not offered",
     )
     surface_energy_colour_filter: bool = Field(
         True,
@@ -73,7 +73,7 @@ class SurfaceTension(Model):
     level_set: Literal["redistanced"] = Field(
         "redistanced",
         description="redistanced: signed distance to the eq. 21 zero contour; eq. 21 as printed "
-        '("raw") is no longer offered',
+        "is not offered",
     )
     level_set_smoothing_passes: int = Field(
         8, ge=0, le=64, description="binomial smoothing passes over phi before the fit"

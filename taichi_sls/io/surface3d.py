@@ -1,5 +1,5 @@
 """The material of a 3D run as a colour on a grid, and its c = 1/2 surface as triangles, in numpy
-(no GPU, no new dependency: PyVista would do it offscreen but costs some 566 MB installed).
+(no GPU, no new dependency: PyVista would do it offscreen but is a large install; docs/running.md).
 
 **Colour.** Each point spreads its share of a point cube (side ``spacing``, the seeding's point
 spacing) onto the nodes of a grid of that same spacing with the quadratic B-spline of the MPM

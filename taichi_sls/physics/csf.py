@@ -56,7 +56,7 @@ def csf_force(cfg: ti.template(), box: ti.template(), nd: ti.template(), surf: t
     # threshold c0 > 0, w = 2 max(c - c0, 0) / (1 - c0)^2 keeps the force across an interface
     # (the integral of w dc over [0, 1] is 1) but gives none to nodes that only a few stray
     # points touch: the CSF acceleration does not fall with node mass, and a lone point in a
-    # concave pocket was flung out of the box.
+    # concave pocket would be flung out of the box.
     c0 = ti.static(cfg.csf_c0)
     full = cfg.rho_ref * cfg.cell_volume
     coef = ramped_gamma(cfg, t) / (cfg.rho_ref * (1.0 - c0) * (1.0 - c0))

@@ -6,7 +6,7 @@
 2. **Redistancing** (``surface_tension.level_set = "redistanced"``, the only reading): the zero
    contour of phi_raw is traced by marching squares (linear interpolation on cell edges, saddles
    resolved by the cell-centre value) and every node within ``band_cells`` of it gets the signed
-   distance to the nearest contour segment (eq. 21 as printed is no longer offered).
+   distance to the nearest contour segment (eq. 21 as printed is not offered).
 3. **Blur** before the curvature fit: ``level_set_smoothing_passes`` binomial passes (a Gaussian
    blur; a circle stays a circle, shrunk by sigma^2 / 2R).
 

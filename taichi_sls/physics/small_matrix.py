@@ -13,8 +13,8 @@ from taichi_sls.backend import ti
 class _Constant:
     """A constant float matrix (or vector) by its shape, as a Python list that ``ti.Matrix``
     takes: ``ti.Matrix(ZERO_MATRIX[3, 3])`` is ``ti.Matrix(ZERO_MATRIX[3, 3])``, whose element-
-    by-element expansion the front end pays for at every call site (about 1 ms each; the
-    constant is one node)."""
+    by-element expansion the front end pays for at every call site (the constant is one
+    node)."""
 
     def __init__(self, build) -> None:
         self.build = build

@@ -31,7 +31,7 @@ The surface energy of the bodies is gamma times the length of their outline. On 
 In 3D (``domain.dim = 3``) the energy is gamma times the area: the filter runs along z too, the
 surface is cut by marching tetrahedra (physics/tetra.py), the force is taken at three points
 of each triangle with (I - n n^T) (:func:`triangle_force`) and the floor spreads to the 3x3x3
-neighbours. The 2D code path is kept as it was, bit for bit.
+neighbours.
 
 Arguments: ``cfg`` (its ``se`` holds this method's switches), ``box`` the active region, ``nd``
 the nodes (``mass``, ``volume``, ``colour``, ``surface_force``, and ``force`` that it adds to).

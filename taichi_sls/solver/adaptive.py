@@ -159,7 +159,7 @@ class AdaptiveStepper:
         self.last_dt = self.dt  # the last step taken
         self.handback_below = 0.0  # hybrid: no step shorter than this (solver/handover.py)
         self.refused = 0  # steps redone smaller, over the run
-        # the points before the step, on the device (a host copy cost a fifth of a step)
+        # the points before the step, kept on the device (a host copy costs much of a step)
         self.before = struct_type(POINT_MEMBERS, st.cfg.dim).field(
             shape=st.n_points, layout=ti.Layout.SOA
         )

@@ -155,7 +155,7 @@ def row_field(grid: tuple[int, ...], row: tuple[int, ...], sparse: bool) -> ti.F
     """A field of one row per grid node (``row`` its shape): dense over the grid, or (3D,
     ``sparse``) a pointer over blocks of ROW_BLOCK^3 nodes, each block allocated when the step
     first writes into it, so that the rows' memory follows the nodes near material and not the
-    whole grid (issue #39 item 5). An unwritten row reads 0."""
+    whole grid. An unwritten row reads 0."""
     if not sparse:
         return ti.field(float, grid + row)
     f = ti.field(float)
@@ -172,7 +172,7 @@ class ImplicitFields:
     over the WIDTH^dim nodes around it; the internal force; which velocity components are free
     (1) and their unknown's index (-1: none). The fixed part is a scalar times the identity in
     the components (one value per neighbour, not dim x dim: 1 kB of a node's 10 in 3D, where
-    the full rows took 18)."""
+    the full rows would take 18)."""
 
     def __init__(self, cfg: StepConfig) -> None:
         grid = tuple(cfg.shape)

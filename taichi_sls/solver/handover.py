@@ -1,11 +1,11 @@
 """Explicit steps, then implicit ones (``time.integrator = "hybrid"``).
 
 The paper's melt collapses inertially while it melts: its answer needs steps of 1e-8-1e-7 s
-there (docs/record/implicit.md), where an explicit step costs some 0.35 ms and an implicit one
-15-20 ms. Once every laser is off and the motion has died down (the kinetic energy, times the
-inertia scale, below ``time.handover_kinetic_fraction`` of the surface energy) nothing is left
-that the explicit limits need to resolve, and the adaptive implicit step (solver/adaptive.py)
-takes over to run on to refreezing or through a long hold in steps of milliseconds.
+there (docs/record/implicit.md), where an explicit step costs far less than an implicit one.
+Once every laser is off and the motion has died down (the kinetic energy, times the inertia
+scale, below ``time.handover_kinetic_fraction`` of the surface energy) nothing is left that
+the explicit limits need to resolve, and the adaptive implicit step (solver/adaptive.py) takes
+over to run on to refreezing or through a long hold in steps of milliseconds.
 
 Both integrators step the same fields: the explicit one through a second view of the state
 with the explicit step's configuration (its heat clock, mass cut-off, FLIP share), compiled on

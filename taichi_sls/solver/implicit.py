@@ -21,8 +21,8 @@ One step, over the explicit step's stages (solver/step.py) where they are the sa
 The internal force of the new stress is taken on the configuration at t^n, where the shape
 functions are evaluated: f_i = -V_p^n sigma^{n+1} grad N_i(x_p^n), linear in the stress, so that
 the material tangent is the whole tangent (the first Piola form det(f) sigma f^-T of the step,
-f = I + dt L, added a geometric nonlinearity that the material tangent missed: Newton stalled
-and Hopper's pair blew up at 20x the capillary limit).
+f = I + dt L, would add a geometric nonlinearity that the material tangent misses: Newton
+stalls and a large step blows up).
 
 Linear solver (``time.linear_solver``, solver/linear_solve.py): an LDL^T factorization up to
 ``direct_max_unknowns``, else pyamg's smoothed aggregation, either kept as the preconditioner of
@@ -266,7 +266,7 @@ class ImplicitStepper:
         """Compile every kernel of the step (of ``stepper``'s, which wraps this one) by taking
         a step of WARM_UP_FRACTION of dt from the state as it is and putting everything it
         changed back: so that the run's first implicit step, a hybrid's hand-over, does not pay
-        seconds of compilation inside its stepping time."""
+        for compilation inside its stepping time."""
         st = self.st
         saved = checkpoint.capture(st)
         scalars = struct_copy.to_numpy(st.scalars)

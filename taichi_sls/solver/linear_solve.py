@@ -9,7 +9,7 @@ iterations (the matrix has drifted) the factorization is refreshed.
 A solve may ask for a fresh factorization (``refresh``): the implicit step asks whenever it
 takes a new tangent, and solves with that very matrix over its next Newton iterations (direct:
 the factorization alone, no CG). CG is written out here (``preconditioned_cg``): its iterations
-are few, and scipy's wrapper cost as much per call as two of them.
+are few, and scipy's wrapper adds a per-call overhead of the order of theirs.
 
 - ``direct``: CHOLMOD's supernodal Cholesky (through cvxopt; its numeric refactorization reuses
   the symbolic one while the pattern is unchanged), or where a matrix is not positive definite
@@ -146,9 +146,9 @@ class LinearSolver:
 
 class DirectFactor:
     """A factorization of a symmetric matrix A (CSR, both triangles stored) that a matrix of the
-    same pattern can refresh: CHOLMOD's supernodal Cholesky of A's lower triangle, some four
-    times faster than qdldl's simplicial LDL^T on the implicit step's matrices; qdldl where
-    Cholesky finds A not positive definite."""
+    same pattern can refresh: CHOLMOD's supernodal Cholesky of A's lower triangle, faster than
+    qdldl's simplicial LDL^T on the implicit step's matrices (docs/record/implicit.md); qdldl
+    where Cholesky finds A not positive definite."""
 
     def __init__(self, A: sp.csr_matrix) -> None:
         from cvxopt import matrix, spmatrix

@@ -128,7 +128,7 @@ class Necks:
     def _contact_necks(self, field_of) -> list[float]:
         """neck_section of every contact on ``field_of(a, b)``, sampled out to
         :func:`~taichi_sls.solver.neck_section.pair_reach`: the coalesced end state of the
-        pair, so a neck is followed past the bodies' initial diameter (issue #40 item 6). 3D:
+        pair, so a neck is followed past the bodies' initial diameter. 3D:
         the diameter 2 sqrt(A / pi) of the section."""
         centre, r, cfg = self.body_centres_m(), self.body_radii_m, self.state.cfg
         return [

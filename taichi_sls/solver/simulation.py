@@ -49,8 +49,8 @@ def init_taichi(
     threads: int = 0,
 ) -> None:
     """(Re)initialise Taichi. Re-initialising frees every field, so one Simulation is live at a
-    time. ``optimize=False`` skips Taichi's advanced IR optimisation: the fused step compiles in
-    seconds instead of about 100 s and runs about 1.1-1.5x slower. ``fast_math=False``: strict
+    time. ``optimize=False`` skips Taichi's advanced IR optimisation: the fused step compiles many
+    times faster and runs somewhat slower (docs/record/compile.md). ``fast_math=False``: strict
     IEEE arithmetic (the compiler may not reorder sums), so that a change of code structure that
     keeps every formula keeps every result bit for bit."""
     taichi_patches.install(ti)  # Taichi's front end memoized (taichi_patches/front_end.py)

@@ -146,8 +146,8 @@ def threads(case: Case) -> int:
 def choose_layout(case: Case, n_points: int) -> Layout:
     """``solver.layout``; "auto": parallel on a GPU; on a CPU the blocks layout for large 2D
     scenes when there is more than one thread, else the serial one (3D on a CPU: serial, as the
-    parallel layout's atomic scatters cost 2.6x its CPU time and were slower in wall time too;
-    docs/record/speed.md, ``taichi-sls bench speed3d``)."""
+    parallel layout's atomic scatters cost more CPU time than the serial loops and more wall
+    time too; docs/record/speed.md, ``taichi-sls bench speed3d``)."""
     lay = case.solver.layout
     if lay != "auto":
         return Layout[lay.upper()]

@@ -2,10 +2,11 @@
 
 Taichi's ``StructField.from_numpy`` and each member field's ``to_numpy`` / ``from_numpy`` copy
 member by member, each through a kernel of its own that compiles (front end and JIT) the first
-time, ~25 ms each: the materials' 40 members, the checkpoint's 19 point members both ways, the
-monitors' totals. One kernel copies any set of members (scalars, vectors and matrices) at
-once through a float64 table, one row per element and one column per component (exact for the
-f32, f64 and i32 members the solver's structs hold), with the same values as Taichi's.
+time (docs/record/compile.md): the materials' 40 members, the checkpoint's 19 point members
+both ways, the monitors' totals. One kernel copies any set of members (scalars, vectors and
+matrices) at once through a float64 table, one row per element and one column per component
+(exact for the f32, f64 and i32 members the solver's structs hold), with the same values as
+Taichi's.
 
 Which field, which members and which way are chosen at run time (a column per member, or -1),
 so the struct fields of one :class:`CopyGroup` (a run's state: :func:`share_kernel`) compile

@@ -1,4 +1,4 @@
-"""A pair in the sintering window against Hopper (cases/pair_window.toml; issue #40 item 5):
+"""A pair in the sintering window against Hopper (cases/pair_window.toml):
 ``taichi-sls bench window [--out renders] [--set KEY=VALUE]``.
 
 The paper's pulse melts a PA12 pair on a 172 C bed; the melt lives (crystallisation kinetics)
@@ -26,7 +26,7 @@ from .sinter_hold import compare, print_against_hopper, run_or_reuse
 
 CASE = "pair_window"
 ALIGN_S = 1e-3  # the pulse is over and the pair molten through by then
-TAU_END = 2.0  # the issue's bar: within 5 % at every tau up to 2
+TAU_END = 2.0  # the comparison's range: the neck within 5 % of Hopper's at every tau up to 2
 REPORT_TAU = (0.5, 1.0, 1.5, 2.0)
 
 

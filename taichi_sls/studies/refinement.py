@@ -224,11 +224,10 @@ DESCRIPTION = (
     "The paper's cases under refinement: each case at each spacing to 1 ms (dt = 2.5e-8 s per "
     "um of h), and at h = --at at every dt factor; writes refinement.csv, refinement_table.md "
     "(observed order, Richardson estimate, dt sensitivity) and refinement.png. Finished runs "
-    "are read, not run again. Run time (cost ~ points x steps, 0.25-0.5 us per point-step on "
-    "two cores, plus 20-40 s of compilation a run): a case to 1 ms at h = 4 / 2 / 1 / 0.5 um "
-    "(632 / 2.5k / 10k / 40k points, 10k / 20k / 40k / 80k steps) 2-3 s / 15-25 s / 2-3.5 min / "
-    "15-27 min, dt/2 and dt/4 at h = 2 um 0.5-1.5 min, so 20-35 min a case and 1.5-2.5 h for the "
-    "default four; --refrozen (20-40 ms, 20-40x the steps) 2-4 h a laser case."
+    "are read, not run again. Run time goes as points x steps, plus the compilation of each "
+    "run: each halving of h takes 4x the points and 2x the steps, so the finest spacing costs "
+    "most; --refrozen runs on to refreezing (20-40 ms, 20-40x the steps). "
+    "docs/record/convergence.md records such runs."
 )
 
 

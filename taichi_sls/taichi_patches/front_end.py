@@ -5,12 +5,12 @@ Taichi's Python front end (AST -> IR) runs for every kernel on every process sta
 cache or not, and for each AST node it visits it formats a source excerpt (file, line and the
 code underlined, wrapped by ``textwrap``) into the node's debug info. A ``ti.func`` is parsed
 and visited again at each call site, and a ``ti.static`` loop visits its body once per
-iteration, so the same excerpt is formatted many times: that formatting was about half of the
-front end's time, and reading the function's source again (``inspect`` tokenizes its module
-to find it) at each call site a quarter of the rest (docs/record/compile.md). This memoizes both: an
-excerpt by the node's position in its source, the source by the function. The texts are the
-same, byte for byte, as Taichi's, so error messages do not change; a source file edited while
-the process runs is read as it was at its first compile (as Python's own ``linecache``).
+iteration, so the same excerpt is formatted many times: that formatting, and reading the
+function's source again (``inspect`` tokenizes its module to find it) at each call site, are
+much of the front end's time (docs/record/compile.md). This memoizes both: an excerpt by the
+node's position in its source, the source by the function. The texts are the same, byte for
+byte, as Taichi's, so error messages do not change; a source file edited while the process
+runs is read as it was at its first compile (as Python's own ``linecache``).
 
 Two more pieces of ``textwrap`` work go the same way. Each excerpt not yet seen wraps its code
 line and its caret line at 80 columns with a new ``textwrap.TextWrapper``: a line that already
