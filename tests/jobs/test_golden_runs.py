@@ -134,9 +134,9 @@ def _differences(want, got, path: str = "", rel: float = 0.0) -> list[str]:
     return [] if want == got else [f"{path}: {got!r}, want {want!r}"]
 
 
-# on request (-m slow): the implicit 3D pair and the settled implicit 2D bed, the longest two
-# (~30-60 s each); their kinds of step and scene stay in default through the other five
-SLOW = {"pair3d_settled_hybrid", "bed2d_implicit_settled"}
+# on request (-m slow): the three that settle first, the longest (~15-60 s each); 2D and 3D,
+# pair and bed, explicit, implicit and hybrid steps stay in default through the other four
+SLOW = {"pair3d_settled_hybrid", "bed2d_implicit_settled", "pair2d_settled_hybrid"}
 
 
 @pytest.mark.parametrize(

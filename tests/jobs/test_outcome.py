@@ -194,6 +194,9 @@ def test_a_warmed_pair_is_not_fused_and_stops_soon_after_the_beam(tmp_path):
     assert iio.imread(tmp_path / "warm" / "timeseries.png").shape[:2] == (320, 840)
 
 
+# slow: a pair cooled to solid (~20 s); the stop rule stays in default
+# (test_a_warmed_pair_is_not_fused_and_stops_soon_after_the_beam)
+@pytest.mark.slow
 def test_a_molten_pair_stops_when_everything_is_below_T_c(tmp_path):
     """A pair started fully molten at 200 C on the 140 C plate, no laser: the run ends by
     itself once every point is below T_c, and the energy balance holds to round-off over the

@@ -140,6 +140,9 @@ def test_a_redone_step_starts_from_the_state_before_it():
         assert np.array_equal(first[k], again[k]), k
 
 
+# slow: the blocks layout's redo (~20 s); the serial redo stays in default
+# (test_a_redone_step_starts_from_the_state_before_it)
+@pytest.mark.slow
 def test_a_step_refused_by_newton_keeps_the_energy_balance_in_blocks(monkeypatch):
     """A step whose Newton fails is redone after its heat has run: under the blocks layout the
     per-block sums of laser energy and heat out that it left must not reach the run's totals

@@ -317,6 +317,9 @@ def test_implicit_step_takes_heat_substeps():
     assert resolve_dt(auto)[0] == pytest.approx(auto.time.implicit_step_factor * explicit)
 
 
+# slow (~15 s): backward-Euler heat's balance to round-off stays in default
+# (tests/physics/test_process.py, test_top_loss_backward_euler_heat_balances_to_round_off)
+@pytest.mark.slow
 def test_implicit_heat_keeps_the_energy_balance():
     """The 25 W pair (coarse grid) over the laser pulse and after, implicit steps of 5 us (95x
     the explicit step; 10 us moves the collapsing point contact over half a cell in the first
