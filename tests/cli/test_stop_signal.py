@@ -28,22 +28,29 @@ def _wait_for(path: Path, proc: subprocess.Popen, timeout_s: float = 300.0) -> N
         time.sleep(0.05)
 
 
-def test_sigterm_stops_a_3d_run_within_two_seconds(tmp_path):
-    out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "taichi_sls.run", "bed3d_cooling", "--out", str(out)]
-    cmd += ["--no-progress", *[a for s in SETS for a in ("--set", s)]]
+def _run_and_terminate(case: str, out: Path, sets: list[str], frame: int, wait_s: float):
+    """Run a case in a subprocess, send SIGTERM once its frame ``frame`` is drawn and
+    ``wait_s`` later; returns (exit status, stderr, seconds from the signal to the exit)."""
+    cmd = [sys.executable, "-m", "taichi_sls.run", case, "--out", str(out), "--no-progress"]
+    cmd += [a for s in sets for a in ("--set", s)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        _wait_for(out / "frames" / "frame_0000.png", proc)  # frame 0 drawn: it steps now
-        time.sleep(1.0)
+        _wait_for(out / "frames" / f"frame_{frame:04d}.png", proc)
+        time.sleep(wait_s)
         t0 = time.perf_counter()
         proc.send_signal(signal.SIGTERM)
         err = proc.communicate(timeout=120)[1]
-        stop_s = time.perf_counter() - t0
+        return proc.returncode, err, time.perf_counter() - t0
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == EXIT_CODES["interrupted"], err
+
+
+def test_sigterm_stops_a_3d_run_within_two_seconds(tmp_path):
+    out = tmp_path / "run"
+    # frame 0 drawn: it steps now; a second into the stepping
+    code, err, stop_s = _run_and_terminate("bed3d_cooling", out, SETS, 0, 1.0)
+    assert code == EXIT_CODES["interrupted"], err
     assert stop_s < STOP_WITHIN_S, f"stopped {stop_s:.2f} s after SIGTERM"
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "interrupted"
@@ -63,19 +70,9 @@ def test_sigterm_stops_an_adaptive_run_at_a_step_and_counts_it(tmp_path):
     ends the stepping at the end of the step under way (StepHooks.stop), and the steps taken
     since the last frame are counted with the time they reached."""
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "taichi_sls.run", "sinter_hold", "--out", str(out)]
-    cmd += ["--no-progress", "--set", "output.gif=false"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        _wait_for(out / "frames" / "frame_0003.png", proc)  # stepping past the first frames
-        t0 = time.perf_counter()
-        proc.send_signal(signal.SIGTERM)
-        err = proc.communicate(timeout=120)[1]
-        stop_s = time.perf_counter() - t0
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == EXIT_CODES["interrupted"], err
+    # stepping past the first frames
+    code, err, stop_s = _run_and_terminate("sinter_hold", out, ["output.gif=false"], 3, 0.0)
+    assert code == EXIT_CODES["interrupted"], err
     assert stop_s < STOP_WITHIN_S, f"stopped {stop_s:.2f} s after SIGTERM"
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "interrupted" and s["steps"] >= s["final"]["step"] > 0
