@@ -161,6 +161,7 @@ BENCHMARKS = {
     "packing3d": "the 3D bed generator's packing fraction, per seed",
     "symmetry": "a 3D pair's quarter under two mirror walls against the full domain",
     "spherepair": "3D coalescence of two liquid spheres against Frenkel and Pokluda",
+    "isotropy": "a filleted pair's neck growth at 0, 30 and 45 deg to the grid",
 }
 
 

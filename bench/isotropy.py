@@ -1,0 +1,183 @@
+"""Neck growth against the pair's angle to the grid:
+``taichi-sls bench isotropy [--quick] [--out renders]``.
+
+Hopper's fluid pair joined by a fillet (studies/verification/isotropy.py), its line of centres
+at 0, 30 and 45 deg to x, the mid-plane through the neck on a node line when along x; at R0/h =
+5 (a 2 um fillet, the beds' resolution), 10 (2 um) and 20 (1 um; left out by ``--quick``),
+as the case gives it (Poisson ratio 0.45) and with a Poisson ratio of 0.30 (less nearly
+incompressible: the lever of the trend, docs/record/verification.md, "Neck growth at any
+angle"). Its neck r_n / R0 (the per-contact section on the colour) every
+18.75 us to 150 us. Writes isotropy.csv (every sample), isotropy.json (per run: the worst
+ratio to the pair along x at the same times, the errors against Hopper at tau = 0.5 / 0.75 / 1
+with the clock aligned where r_n / R0 first reaches 0.35, the wall time) and isotropy.png.
+
+``--beds RUN [RUN ...]``: instead, the contacts of finished bed runs (their contacts.csv and
+resolved.toml; e.g. ``python -m taichi_sls.run cases/bed_track.toml --set bed.seed=2 --out
+RUN``): each melted contact's neck growth (final over initial) against its line of centres'
+angle to the grid folded into [0, 45] deg, the least-squares slope per run with its standard
+error; isotropy_bed.csv, isotropy_bed.json and isotropy_bed.png.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from taichi_sls.io.atomic import atomic_write_text, write_rows
+from taichi_sls.studies.verification.isotropy import (
+    angle_trend,
+    contact_growth_by_angle,
+    fillet_pair,
+    hopper_errors,
+    neck_history,
+)
+
+TIMES = np.linspace(0.0, 150e-6, 9)
+ANGLES = (0.0, 30.0, 45.0)
+GRIDS = ((5.0, 2.0), (10.0, 2.0), (20.0, 1.0))  # (R0/h, fillet radius in um)
+VARIANTS = {  # name: the case keys it sets
+    "nu0.45": {},
+    "nu0.30": {"materials": {"fluid": {"poisson": 0.30}}},
+}
+TAUS = (0.5, 0.75, 1.0)
+ALIGN = 0.35  # cases/verification/hopper.toml's hopper_align
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    ap = sub.add_parser("isotropy", help="a filleted pair's neck growth at 0, 30 and 45 deg")
+    ap.add_argument("--quick", action="store_true", help="R0/h = 5 and 10 only")
+    ap.add_argument("--out", default="renders", help="folder for the CSV, JSON and plot")
+    ap.add_argument("--beds", nargs="+", metavar="RUN", help="bed runs' folders: their contacts")
+    ap.set_defaults(func=main)
+
+
+def main(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    if args.beds:
+        return beds(args.beds, out)
+    grids = GRIDS[:2] if args.quick else GRIDS
+    rows, runs = [], []
+    for R0_over_h, fillet_um in grids:
+        for variant, sets in VARIANTS.items():
+            along_x = None
+            for angle in ANGLES:
+                vc = fillet_pair(angle, R0_over_h, fillet_um, sets)
+                hist = neck_history(vc, TIMES)
+                along_x = hist.neck if along_x is None else along_x
+                worst = float(np.max(np.abs(hist.neck / along_x - 1.0)))
+                errors = hopper_errors(hist, TAUS, ALIGN)
+                runs.append(
+                    {
+                        "R0_over_h": R0_over_h,
+                        "fillet_um": fillet_um,
+                        "variant": variant,
+                        "angle_deg": angle,
+                        "worst_ratio_to_along_x": worst,
+                        **{f"hopper_error_tau{q:g}": e for q, e in errors.items()},
+                        "wall_s": hist.wall_s,
+                        "steps": hist.steps,
+                    }
+                )
+                rows += [
+                    {
+                        "R0_over_h": R0_over_h,
+                        "fillet_um": fillet_um,
+                        "variant": variant,
+                        "angle_deg": angle,
+                        "t_us": round(t * 1e6, 3),
+                        "neck_over_R0": round(n, 6),
+                    }
+                    for t, n in zip(hist.times, hist.neck, strict=True)
+                ]
+                print(
+                    f"R0/h {R0_over_h:4g}  {variant:6s}  {angle:4g} deg  r_n/R0 "
+                    f"{hist.neck[0]:.4f} -> {hist.neck[-1]:.4f}  worst ratio to 0 deg "
+                    f"{worst * 100:5.2f} %  Hopper "
+                    + " / ".join(f"{e * 100:+.2f}" for e in errors.values())
+                    + f" %  ({hist.wall_s:.0f} s)",
+                    flush=True,
+                )
+    write_rows(out / "isotropy.csv", rows)
+    atomic_write_text(out / "isotropy.json", json.dumps(runs, indent=1) + "\n")
+    plot(rows, out / "isotropy.png")
+    return 0
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    grids = sorted({r["R0_over_h"] for r in rows})
+    fig, axes = plt.subplots(1, len(grids), figsize=(4.2 * len(grids), 3.6), squeeze=False)
+    for ax, g in zip(axes[0], grids, strict=True):
+        for variant, style in zip(VARIANTS, ("-", "--"), strict=True):
+            for angle, colour in zip(ANGLES, ("C0", "C1", "C2"), strict=True):
+                sel = [
+                    r
+                    for r in rows
+                    if (r["R0_over_h"], r["variant"], r["angle_deg"]) == (g, variant, angle)
+                ]
+                t = [r["t_us"] for r in sel]
+                n = [r["neck_over_R0"] for r in sel]
+                ax.plot(t, n, style, color=colour, label=f"{angle:g} deg, {variant}")
+        ax.set_title(f"R0/h = {g:g}")
+        ax.set_xlabel("t (us)")
+        ax.set_ylabel("r_n / R0")
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def beds(runs: list[str], out: Path) -> int:
+    """Neck growth against contact angle in each bed run (module docstring)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows, trends = [], []
+    fig, ax = plt.subplots(figsize=(5.5, 3.8))
+    for k, run in enumerate(runs):
+        contacts = contact_growth_by_angle(Path(run))
+        slope, err = angle_trend(contacts)
+        growth = [c["growth"] for c in contacts]
+        trends.append(
+            {
+                "run": str(run),
+                "contacts": len(contacts),
+                "mean_growth": float(np.mean(growth)),
+                "slope_per_45deg": slope,
+                "slope_standard_error": err,
+            }
+        )
+        rows += [{"run": str(run), **c} for c in contacts]
+        ax.plot(
+            [c["angle_deg"] for c in contacts],
+            growth,
+            "o",
+            ms=3,
+            color=f"C{k}",
+            label=Path(run).name,
+        )
+        print(
+            f"{run}: {len(contacts)} melted contacts, mean growth {np.mean(growth):.4f}, slope "
+            f"{slope:+.4f} +- {err:.4f} per 45 deg"
+        )
+    ax.set_xlabel("line of centres to the grid (deg, folded into [0, 45])")
+    ax.set_ylabel("neck growth, final / initial")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "isotropy_bed.png", dpi=90)
+    plt.close(fig)
+    write_rows(out / "isotropy_bed.csv", rows)
+    atomic_write_text(out / "isotropy_bed.json", json.dumps(trends, indent=1) + "\n")
+    return 0
