@@ -238,6 +238,19 @@ class Thermal(Model):
         0.0, ge=0, description="top_surface = chamber: the convection coefficient h (W/(m^2 K))"
     )
 
+    imposed_temperature_csv: str | None = Field(
+        None,
+        description="a temperature history that every point is held at: a CSV file, relative "
+        "to the case file, with columns t_s (s, from 0, increasing) and T_C (C), linear between "
+        "rows and the last value after them (config/temperature_table.py). Each heat step sets "
+        "every point to T(t) at the step's end, its solid fraction following as at any "
+        "temperature (melting above the melting range, crystallisation kinetics at the held "
+        "temperature), and books the heat this takes in heat_out. It assumes no gradient inside "
+        "a particle (Biot number << 1: the pair is isothermal) and replaces conduction and every "
+        "heat source: allowed without lasers, fixed-temperature walls or a chamber top surface "
+        "(docs/validation.md)",
+    )
+
     def chamber_temperature_C(self) -> float:
         """T_ch (C): chamber_C, or the initial temperature."""
         return self.initial_C if self.chamber_C is None else self.chamber_C

@@ -51,6 +51,8 @@ from ..physics.thermal import (
     g2p_heat,
     grid_heat,
     grid_temperature,
+    hold_temperature,
+    imposed_temperature,
     p2g_heat_capacity,
     p2g_heat_flux,
 )
@@ -251,8 +253,15 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
                 chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
             dt_heat = heat_step(st)  # = dt heat_every explicit; dt_heat[None] implicit
-            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
-            if ti.static(st.cfg.any_fixed):
+            dT, dxi, q = 0.0, 0.0, 0.0
+            if ti.static(st.cfg.imposed):  # held at the table's T at the heat step's end
+                T_held = imposed_temperature(
+                    st.imposed, st.cfg.imposed, st.scalars.t[None] + dt_heat
+                )
+                dT, dxi, q = hold_temperature(st.cfg, pt, mat, p, T_held, dt_heat)
+            else:
+                dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
+            if ti.static(st.cfg.any_fixed or st.cfg.imposed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
             if counts_molten(st.cfg, mat[pt.material[p]], pt.solid_fraction[p]):
