@@ -89,6 +89,9 @@ def run_command(args: argparse.Namespace) -> int:
         writable_folder(out)
         if args.checkpoint_every < 0:
             raise CaseError(f"--checkpoint-every {args.checkpoint_every}: must be >= 0")
+        from .studies.validation.neck import validation_observers
+
+        hooks["observers"] = validation_observers(case, out)  # output.validation
     except CaseError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -34,6 +34,7 @@ from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
+from ..physics.held_temperature import hold_at_table
 from ..physics.level_set import scatter_level_set
 from ..physics.mechanics import (
     g2p_kinematics,
@@ -51,8 +52,6 @@ from ..physics.thermal import (
     g2p_heat,
     grid_heat,
     grid_temperature,
-    hold_temperature,
-    imposed_temperature,
     p2g_heat_capacity,
     p2g_heat_flux,
 )
@@ -255,10 +254,8 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             dt_heat = heat_step(st)  # = dt heat_every explicit; dt_heat[None] implicit
             dT, dxi, q = 0.0, 0.0, 0.0
             if ti.static(st.cfg.imposed):  # held at the table's T at the heat step's end
-                T_held = imposed_temperature(
-                    st.imposed, st.cfg.imposed, st.scalars.t[None] + dt_heat
-                )
-                dT, dxi, q = hold_temperature(st.cfg, pt, mat, p, T_held, dt_heat)
+                t_end = st.scalars.t[None] + dt_heat
+                dT, dxi, q = hold_at_table(st.cfg, pt, mat, st.imposed, p, t_end, dt_heat)
             else:
                 dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
             if ti.static(st.cfg.any_fixed or st.cfg.imposed):
