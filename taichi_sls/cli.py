@@ -149,6 +149,10 @@ STUDIES = {
         "the paper's cases under grid and dt refinement",
     ),
     "process": ("taichi_sls.studies.process.study", "a PA12 layer's density against the process"),
+    "tornado": (
+        "taichi_sls.studies.validation.tornado",
+        "the held pulsed pair's neck across published input ranges",
+    ),
 }
 # the developer's benchmarks, bench/NAME.py in a checkout (not installed): what they measure
 BENCHMARKS = {
