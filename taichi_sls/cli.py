@@ -89,6 +89,9 @@ def run_command(args: argparse.Namespace) -> int:
         writable_folder(out)
         if args.checkpoint_every < 0:
             raise CaseError(f"--checkpoint-every {args.checkpoint_every}: must be >= 0")
+        from .studies.validation.neck import validation_observers
+
+        hooks["observers"] = validation_observers(case, out)  # output.validation
     except CaseError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -146,6 +149,10 @@ STUDIES = {
         "the paper's cases under grid and dt refinement",
     ),
     "process": ("taichi_sls.studies.process.study", "a PA12 layer's density against the process"),
+    "tornado": (
+        "taichi_sls.studies.validation.tornado",
+        "the held pulsed pair's neck across published input ranges",
+    ),
 }
 # the developer's benchmarks, bench/NAME.py in a checkout (not installed): what they measure
 BENCHMARKS = {

@@ -17,8 +17,11 @@ import numpy as np
 from .errors import CaseError
 
 
-def read_columns(path: str, key: str, columns: tuple[str, ...]) -> tuple[np.ndarray, list[int]]:
-    """The named columns of a CSV file as an (n, len(columns)) array, with each row's line."""
+def read_columns(
+    path: str, key: str, columns: tuple[str, ...], positive_last: bool = True
+) -> tuple[np.ndarray, list[int]]:
+    """The named columns of a CSV file as an (n, len(columns)) array, with each row's line;
+    ``positive_last``: the last column must be > 0 (a radius or a diameter)."""
     rows, lines, header = [], [], None
     for no, raw in enumerate(Path(path).read_text().splitlines(), start=1):
         text = raw.split("#", 1)[0].strip()
@@ -45,10 +48,10 @@ def read_columns(path: str, key: str, columns: tuple[str, ...]) -> tuple[np.ndar
             raise CaseError(
                 f"{key} = {path!r} line {no}: {text!r}: {', '.join(columns)} must be numbers"
             ) from None
-        if not all(math.isfinite(v) for v in values) or values[-1] <= 0:
+        if not all(math.isfinite(v) for v in values) or (positive_last and values[-1] <= 0):
+            allowed = f" and {columns[-1]} > 0" if positive_last else ""
             raise CaseError(
-                f"{key} = {path!r} line {no}: {text!r}: finite numbers and {columns[-1]} > 0 "
-                "are allowed"
+                f"{key} = {path!r} line {no}: {text!r}: finite numbers{allowed} are allowed"
             )
         rows.append(values)
         lines.append(no)

@@ -118,11 +118,13 @@ def case_from_dict(data: dict) -> ResolvedCase:
 
 
 def resolve_files(data: dict, folder: Path) -> None:
-    """Body and bed files named relative to the case file, made absolute."""
+    """Body, bed and temperature-table files named relative to the case file, made absolute."""
     tables = data.get("bodies", []) if isinstance(data.get("bodies"), list) else []
     keys = [(b, k) for b in tables if isinstance(b, dict) for k in ("vertices_file", "file")]
     if isinstance(data.get("bed"), dict):
         keys += [(data["bed"], k) for k in ("csv", "sizes_csv", "previous_layer")]
+    if isinstance(data.get("thermal"), dict):
+        keys.append((data["thermal"], "imposed_temperature_csv"))
     for table, key in keys:
         f = table.get(key)
         if isinstance(f, str) and not Path(f).is_absolute():

@@ -36,6 +36,7 @@ from .sections import (
 )
 from .surface import SurfaceTension
 from .symmetry import check_symmetry, within_mirrors
+from .temperature_table import read_temperature_table
 
 MAX_CELLS = 2e7  # ~4 GB of grid and 8e7 points at 2x2 per cell: beyond this machine's memory
 
@@ -101,6 +102,7 @@ class Case(Model):
         if self.bed is None:
             self._check_bodies()
         self._check_lasers()
+        self._check_imposed_temperature()
         self._check_solver()
         return self
 
@@ -188,6 +190,34 @@ class Case(Model):
                     f"{key}: extent {span} um lies outside the domain "
                     f"{' x '.join(f'0..{s}' for s in sides)} um"
                 )
+
+    def _check_imposed_temperature(self) -> None:
+        """A held temperature history: its table readable, and nothing else that heats."""
+        path = self.thermal.imposed_temperature_csv
+        if path is None:
+            return
+        key = f"thermal.imposed_temperature_csv = {path!r}"
+        if not self.physics.thermal:
+            raise CaseError(f"{key}: with physics.thermal = false; allowed: physics.thermal = true")
+        read_temperature_table(path)
+        heated = [i for i, las in enumerate(self.lasers) if las.power_W > 0]
+        if heated:
+            raise CaseError(
+                f"{key}: with lasers[{heated[0]}].power_W = {self.lasers[heated[0]].power_W}; "
+                "the held temperature replaces every heat source; allowed: no laser with power"
+            )
+        sides = ("left", "right", "bottom", "top", "front", "back")
+        for side, wall in zip(sides, self.boundary.walls(self.domain.dim), strict=False):
+            if wall.thermal == "fixed":
+                raise CaseError(
+                    f"{key}: with boundary.{side}.thermal = 'fixed'; the held temperature "
+                    "replaces conduction to the walls; allowed: insulated walls"
+                )
+        if self.thermal.top_surface != "insulated":
+            raise CaseError(
+                f"{key}: with thermal.top_surface = {self.thermal.top_surface!r}; the held "
+                "temperature replaces the chamber's loss; allowed: 'insulated'"
+            )
 
     def _check_lasers(self) -> None:
         """Each laser's times and scan keys consistent."""

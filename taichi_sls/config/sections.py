@@ -238,6 +238,17 @@ class Thermal(Model):
         0.0, ge=0, description="top_surface = chamber: the convection coefficient h (W/(m^2 K))"
     )
 
+    imposed_temperature_csv: str | None = Field(
+        None,
+        description="a temperature history every point is held at: a CSV file (relative to the "
+        "case file) with columns t_s (s, from 0, increasing) and T_C (C), linear between rows, "
+        "the last value after them. Each heat step sets every point to T(t); its solid fraction "
+        "follows (melting, crystallisation kinetics at the held T); the heat this takes is "
+        "booked in heat_out. It assumes no gradient inside a particle (Biot number << 1) and "
+        "replaces conduction and every heat source: no lasers, fixed-temperature walls or "
+        "chamber top surface (docs/validation.md)",
+    )
+
     def chamber_temperature_C(self) -> float:
         """T_ch (C): chamber_C, or the initial temperature."""
         return self.initial_C if self.chamber_C is None else self.chamber_C
@@ -394,4 +405,16 @@ class Output(Model):
     )
     deformation: Literal["displacement", "plastic_strain"] = Field(
         "displacement", description="what the right-hand panel colours the points by"
+    )
+    validation: Literal["none", "pulse_pair_R125"] = Field(
+        "none",
+        description="a measured neck of the package (taichi_sls/data/pa12) beside the pair's "
+        "a / R (bodies 0 and 1 of one radius R; a = half the contact line): validation.png and "
+        "validation.csv in the run's folder (docs/validation.md). pulse_pair_R125: the "
+        "laser-pulsed PA12 pair of R = 125 um (Hejmady et al.); none: no comparison",
+    )
+    validation_up_to_s: float = Field(
+        1.0,
+        gt=0,
+        description="validation: the largest |error| of a / R is over the times up to this (s)",
     )

@@ -33,6 +33,9 @@ by Nakamura's law over the heat step at that T, at the same enthalpy, so the lat
 releases raises T (physics/materials.py ``crystallize_at_enthalpy``). The carried enthalpy is
 untouched: the energy balance holds as before.
 
+Held temperature (``cfg.imposed``): every point is set to a table's T(t) instead of taking the
+grid's increment (physics/held_temperature.py).
+
 Fixed-temperature walls: their nodes enter the gradient at the wall temperature and take no
 increment; the heat that reaches them leaves the body and is counted in ``heat_out``. Points next
 to them are updated as ``g2p_heat`` says, so that none is pushed past the wall temperature

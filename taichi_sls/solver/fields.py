@@ -20,10 +20,12 @@ Nodes (``nodes``, the grid of ``nx x ny``):
   surface_force (before the mass floor).
 Scalars (``scalars``): t, step (steps taken: the phase of the clocks), dt, dt_heat (the heat
   substep of the implicit step), laser_energy,
-  heat_out (heat through fixed-temperature walls), T_peak (running maximum), and for each of
-  WATCHED the first step at which a point showed it (NEVER if none), so that the guard, which
-  looks once per frame, can name what broke first.
+  heat_out (heat through fixed-temperature walls, and the heat a held temperature takes),
+  T_peak (running maximum), and for each of WATCHED the first step at which a point showed it
+  (NEVER if none), so that the guard, which looks once per frame, can name what broke first.
 Totals (``totals``): the monitors' reductions over the points (solver/monitor.py).
+Imposed (``imposed``): the rows (t in s, T in K) of the temperature history every point is held
+at (``thermal.imposed_temperature_csv``; physics/thermal.py ``hold_temperature``).
 """
 
 import numpy as np
@@ -210,6 +212,7 @@ class State:
         materials: dict[str, np.ndarray],
         lasers: dict[str, np.ndarray],
         blocks=None,
+        imposed: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.cfg = cfg
         self.blocks = blocks  # the blocks layout's plan (solver/blocks.py), else None
@@ -238,18 +241,26 @@ class State:
         # active region [i0, j0, i1, j1) ([i0, j0, k0, i1, j1, k1) in 3D): lower corner, upper
         self.box = ti.Vector.field(2 * cfg.dim, ti.i32, ())
         self.totals = ti.types.struct(**{k: float for k in TOTALS}).field(shape=())
+        # the held temperature history (thermal.imposed_temperature_csv): t (s), T (K) per row;
+        # one unused row when none
+        self.imposed = ti.types.struct(t=float, T=float).field(shape=max(cfg.imposed, 1))
         self.implicit = ImplicitFields(cfg) if cfg.implicit else None
         structs = [self.points, self.nodes, self.scalars, self.materials, self.lasers, self.totals]
         if self.implicit is not None:
             structs.append(self.implicit.numbering)
         struct_copy.share_kernel(*structs)  # one copy kernel for all of them
-        self._fill(materials, lasers)
+        self._fill(materials, lasers, imposed)
 
     @property
     def n_points(self) -> int:
         return self.cfg.n_points
 
-    def _fill(self, materials: dict[str, np.ndarray], lasers: dict[str, np.ndarray]) -> None:
+    def _fill(
+        self,
+        materials: dict[str, np.ndarray],
+        lasers: dict[str, np.ndarray],
+        imposed: tuple[np.ndarray, np.ndarray] | None,
+    ) -> None:
         cfg, sc = self.cfg, self.scene
         struct_copy.from_numpy(self.materials, materials)
         rho = materials["density_kg_m3"][sc.material]
@@ -265,6 +276,10 @@ class State:
         self.box[None] = list(cfg.shape) + [0] * cfg.dim if cfg.active_region else full
         if cfg.n_lasers:
             struct_copy.from_numpy(self.lasers, lasers)
+        if cfg.imposed:
+            t_s, T_K = imposed
+            self.imposed.t.from_numpy(np.asarray(t_s, dtype=np.float64))
+            self.imposed.T.from_numpy(np.asarray(T_K, dtype=np.float64))
         self.scalars.t[None] = 0.0
         self.scalars.T_peak[None] = float(np.max(sc.T0_C + KELVIN))
         for k in WATCHED:

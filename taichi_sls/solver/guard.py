@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..config.temperature_table import read_temperature_table
 from ..physics.materials import KELVIN
 from .fields import NEVER, WATCHED, State
 from .monitor import Trouble, grid_reach
@@ -17,12 +18,15 @@ from .step_config import T_RUNAWAY_K
 def temperature_floor_K(case: Any, dim: int, coldest_start_C: float) -> float:
     """The coldest temperature a point may reach (K): its start's, a fixed wall's or the
     chamber's that the top surface loses heat to (conduction obeys a maximum principle, and the
-    chamber draws the surface only towards its own temperature); -inf where heat is off."""
+    chamber draws the surface only towards its own temperature) or the held temperature's
+    coldest (thermal.imposed_temperature_csv); -inf where heat is off."""
     if not case.physics.thermal:
         return -math.inf
     walls = [w.temperature_C for w in case.boundary.walls(dim) if w.thermal == "fixed"]
     if case.thermal.top_surface == "chamber":
         walls.append(case.thermal.chamber_temperature_C())
+    if case.thermal.imposed_temperature_csv is not None:  # the held temperature's coldest
+        walls.append(float(read_temperature_table(case.thermal.imposed_temperature_csv)[1].min()))
     return min([coldest_start_C, *walls]) + KELVIN
 
 

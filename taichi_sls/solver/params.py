@@ -11,6 +11,7 @@ import numpy as np
 
 from ..config import Case, Material
 from ..config.materials import CrystallizationKinetics
+from ..config.temperature_table import read_temperature_table
 from ..physics.codes import ViscosityModel
 from ..physics.laser import LASER_MEMBERS
 from ..physics.materials import INT_MEMBERS, KELVIN, KINETICS_RANGE_K, MATERIAL_MEMBERS
@@ -121,6 +122,16 @@ def laser_arrays(case: Case) -> dict[str, np.ndarray]:
 # it: time.safety (0.4) covers the two acting together. The same eigenvalue 4 d / h^2 sets the
 # thermal limit h^2 rho c / (2 d k) (eq. 48's h^2 / 4 alpha in 2D) and scales the elastic one,
 # written h / c_p in 2D, by sqrt(2 / d).
+def imposed_table(case: Case) -> tuple[np.ndarray, np.ndarray]:
+    """The held temperature history of ``thermal.imposed_temperature_csv``: times (s) and
+    temperatures (K), as the kernels read them (State.imposed); empty arrays without one."""
+    path = case.thermal.imposed_temperature_csv
+    if path is None:
+        return np.zeros(0), np.zeros(0)
+    t_s, T_C = read_temperature_table(path)
+    return t_s, T_C + KELVIN
+
+
 def viscous_stencil(dim: int = 2) -> float:
     """c = 8 d / 3 of the viscous limit rho h^2 / (c eta_s) in ``dim`` dimensions."""
     return 8.0 * dim / 3.0

@@ -24,7 +24,7 @@ from .handover import Handover, HybridStepper, explicit_view
 from .implicit import ImplicitStepper
 from .monitor import point_monitors
 from .necks import HOST_POINT_MEMBERS, Necks, point_arrays
-from .params import laser_arrays, material_arrays
+from .params import imposed_table, laser_arrays, material_arrays
 from .scene import Scene, build_scene
 from .step import init_box
 from .step_config import Layout, choose_layout, step_config
@@ -120,7 +120,9 @@ class Simulation:
             dt_heat,
         )
         mats = material_arrays(case, self.scene.material_names)
-        self.state = State(cfg, self.scene, mats, laser_arrays(case), self.blocks)
+        self.state = State(
+            cfg, self.scene, mats, laser_arrays(case), self.blocks, imposed_table(case)
+        )
         self.state.scalars.dt[None] = self.dt
         init_box(self.state)
         self.steps = 0

@@ -34,6 +34,7 @@ from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
 from ..physics.grid import active
+from ..physics.held_temperature import hold_at_table
 from ..physics.level_set import scatter_level_set
 from ..physics.mechanics import (
     g2p_kinematics,
@@ -251,8 +252,13 @@ def g2p_point_heat(st: ti.template(), p, blk, base, w, dw, dt, heat: ti.template
             if ti.static(st.cfg.implicit):  # its heat step varies (time.adaptive)
                 chi = 1.0 - ti.exp(-st.cfg.subgrid_rate * st.scalars.dt_heat[None])
             dt_heat = heat_step(st)  # = dt heat_every explicit; dt_heat[None] implicit
-            dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
-            if ti.static(st.cfg.any_fixed):
+            dT, dxi, q = 0.0, 0.0, 0.0
+            if ti.static(st.cfg.imposed):  # held at the table's T at the heat step's end
+                t_end = st.scalars.t[None] + dt_heat
+                dT, dxi, q = hold_at_table(st.cfg, pt, mat, st.imposed, p, t_end, dt_heat)
+            else:
+                dT, dxi, q = g2p_heat(st.cfg, pt, nd, mat, p, base, w, dw, chi, dt_heat)
+            if ti.static(st.cfg.any_fixed or st.cfg.imposed):
                 add_heat_out(st, blk, q)
             peak_temperature(st, blk, pt.T[p])
             if counts_molten(st.cfg, mat[pt.material[p]], pt.solid_fraction[p]):

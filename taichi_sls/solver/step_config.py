@@ -22,6 +22,7 @@ from ..physics.codes import (
 )
 from ..physics.materials import KELVIN
 from ..physics.stiffness import WIDTH as ROW_WIDTH
+from .params import imposed_table
 from .scene import Scene
 
 
@@ -108,6 +109,7 @@ class StepConfig:
     convection: float  # W/(m^2 K)
     hysteresis: bool  # some material crystallises below its melting range (physics/thermal.py)
     kinetics: bool  # some material crystallises by kinetics (hysteresis too; physics/thermal.py)
+    imposed: int  # rows of thermal.imposed_temperature_csv, the held T(t); 0: none (State.imposed)
     # ---- mass and surface tension
     surface_method: SurfaceMethod
     se: SurfaceEnergyConfig
@@ -282,6 +284,7 @@ def step_config(
         ),
         kinetics=thermal
         and any(m.crystallization_kinetics is not None for m in case.materials.values()),
+        imposed=len(imposed_table(case)[0]) if thermal else 0,
         surface_method=method,
         se=SurfaceEnergyConfig(
             weight_lp=h / (2 * case.grid.points_per_cell)

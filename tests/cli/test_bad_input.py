@@ -69,3 +69,20 @@ def test_settling_a_scene_above_its_crystallisation_names_the_cause(tmp_path, ca
     assert code == EXIT_CODES["failed"] != 0
     assert "had not settled" in err and "not solid: peak 150.00 C" in err, err
     assert "crystallisation at 146 C" in err and "Traceback" not in err
+
+
+def test_a_missing_temperature_table_is_one_line(tmp_path):
+    """thermal.imposed_temperature_csv naming no file: one line with the key, the value (made
+    absolute, relative to the case file) and what is allowed; exit status 2."""
+    p = tmp_path / "held.toml"
+    p.write_text(
+        "[[bodies]]\ncenter_um = [40.0, 20.0]\nradius_um = 20.0\n"
+        '[boundary.bottom]\nthermal = "insulated"\n'
+        '[thermal]\nimposed_temperature_csv = "T.csv"\n'
+    )
+    r = run_command(["taichi_sls.run"], p, tmp_path / "o")
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 2, r.stderr
+    assert len(lines) == 1 and "Traceback" not in r.stderr
+    assert f"thermal.imposed_temperature_csv = '{tmp_path / 'T.csv'}': no such file" in lines[0]
+    assert "allowed: a CSV file with columns t_s, T_C" in lines[0]

@@ -18,9 +18,10 @@ from taichi_sls.solver.scene import build_scene
 from taichi_sls.solver.time_step import resolve_dt
 
 CASES = bundled_cases()
+VALIDATION = bundled_cases("validation")
 
 
-@pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
+@pytest.mark.parametrize("path", CASES + VALIDATION, ids=[p.stem for p in CASES + VALIDATION])
 def test_bundled_cases_load(path):
     case = load_case(path)
     assert case.case.name == path.stem
