@@ -153,6 +153,10 @@ STUDIES = {
         "taichi_sls.studies.validation.tornado",
         "the held pulsed pair's neck across published input ranges",
     ),
+    "hotstage": (
+        "taichi_sls.studies.validation.hot_stage",
+        "the hot-stage pairs: one calibrated temperature, ten predicted",
+    ),
 }
 # the developer's benchmarks, bench/NAME.py in a checkout (not installed): what they measure
 BENCHMARKS = {
