@@ -88,3 +88,27 @@ def test_the_scaled_pair_seeds_the_same_neck_at_any_radius(tmp_path):
     assert a.a_over_R[0] == pytest.approx(b.a_over_R[0], abs=1e-9)
     assert a.t_s[-1] == pytest.approx(2e-3)
     assert b.eta_Pas > a.eta_Pas  # 190 C: more viscous than 220 C
+
+
+def test_the_overrides_scale_every_length_of_the_case_with_R(tmp_path):
+    """At the case's own R = 125 um the scaled pair is the case; at R = 25 um every length is a
+    fifth of it (to rounding)."""
+    from taichi_sls.config import load_case
+    from taichi_sls.config.loading import bundled_root
+    from taichi_sls.studies.validation.hot_stage import CASE_PATH, pair_overrides
+
+    base = load_case(bundled_root() / CASE_PATH)
+    table = tmp_path / "held.csv"
+    table.write_text("t_s,T_C\n0.0,200.0\n")
+    same = load_case(bundled_root() / CASE_PATH, pair_overrides(125.0, 200.0, table, 1.0))
+    small = load_case(bundled_root() / CASE_PATH, pair_overrides(25.0, 200.0, table, 1.0))
+    for case, s in ((same, 1.0), (small, 0.2)):
+        assert case.grid.spacing_um == pytest.approx(s * base.grid.spacing_um, rel=1e-12)
+        assert case.domain.width_um == pytest.approx(s * base.domain.width_um, rel=1e-12)
+        assert case.domain.height_um == pytest.approx(s * base.domain.height_um, rel=1e-12)
+        assert case.contact.fillet_radius_um == pytest.approx(
+            s * base.contact.fillet_radius_um, rel=1e-12
+        )
+        for b, b0 in zip(case.bodies, base.bodies, strict=True):
+            assert b.radius_um == pytest.approx(s * b0.radius_um, rel=1e-12)
+            assert list(b.center_um) == pytest.approx([s * c for c in b0.center_um], rel=1e-12)

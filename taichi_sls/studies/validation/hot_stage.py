@@ -33,6 +33,7 @@ from ...jobs.run_loop import Frame, Observer
 from ..references.hopper import hopper_tau_at_neck
 from ..references.viscosity import GAS_CONSTANT, arrhenius_viscosity
 from .measured import NeckPoint, load_hot_stage
+from .neck import pair_radius_um
 
 CASE_PATH = Path("validation") / "pulse_pair_temperature.toml"
 CALIBRATION_SERIES = "Exp21"  # the median radius of the ten Exp series; crosses 0.5 at 1.5-2 s
@@ -82,21 +83,24 @@ class NeckSeries(Observer):
 
 
 def pair_overrides(radius_um: float, T_C: float, table: Path, end_s: float) -> list[str]:
-    """The held pulsed pair (cases/validation/pulse_pair_temperature.toml, R = 125 um) scaled
-    to ``radius_um``, every length with R (grid, domain, centres, fillet), held at ``T_C``."""
-    s = radius_um / 125.0
-    y = 210.0 * s
+    """The held pulsed pair (``CASE_PATH``) scaled to ``radius_um``, every length with R (grid,
+    domain, centres, fillet), held at ``T_C``."""
+    from ...config import load_case
+
+    base = load_case(bundled_root() / CASE_PATH)
+    s = radius_um / pair_radius_um(base)
+    b0, b1 = (list(b.center_um) for b in base.bodies[:2])
     return [
-        f"grid.spacing_um={6.25 * s!r}",
-        f"domain.width_um={600.0 * s!r}",
-        f"domain.height_um={420.0 * s!r}",
+        f"grid.spacing_um={base.grid.spacing_um * s!r}",
+        f"domain.width_um={base.domain.width_um * s!r}",
+        f"domain.height_um={base.domain.height_um * s!r}",
         f"bodies.0.radius_um={radius_um!r}",
         f"bodies.1.radius_um={radius_um!r}",
-        f"bodies.0.center_um=[{175.0 * s!r}, {y!r}]",
-        f"bodies.1.center_um=[{425.0 * s!r}, {y!r}]",
-        f"contact.fillet_radius_um={1.0 * s!r}",
+        f"bodies.0.center_um=[{b0[0] * s!r}, {b0[1] * s!r}]",
+        f"bodies.1.center_um=[{b1[0] * s!r}, {b1[1] * s!r}]",
+        f"contact.fillet_radius_um={base.contact.fillet_radius_um * s!r}",
         f"thermal.initial_C={T_C!r}",
-        f"thermal.imposed_temperature_csv={str(table)!r}".replace("'", '"'),
+        f'thermal.imposed_temperature_csv="{table}"',
         f"time.end_s={end_s!r}",
         'output.validation="none"',
         "output.spacing=linear",
