@@ -153,6 +153,14 @@ STUDIES = {
         "taichi_sls.studies.validation.tornado",
         "the held pulsed pair's neck across published input ranges",
     ),
+    "hotstage": (
+        "taichi_sls.studies.validation.hot_stage",
+        "the hot-stage pairs: one calibrated temperature, ten predicted",
+    ),
+    "laserpair": (
+        "taichi_sls.studies.validation.laser_pair",
+        "the laser-pulsed pair: A calibrated on the peak, the cooling against the measured",
+    ),
 }
 # the developer's benchmarks, bench/NAME.py in a checkout (not installed): what they measure
 BENCHMARKS = {
