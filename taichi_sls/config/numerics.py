@@ -232,6 +232,26 @@ class Solver(Model):
         description="apic; flip as printed (eq. 14); pic_flip: flip_ratio*FLIP + "
         "(1-flip_ratio)*PIC",
     )
+    dilatation: Literal["point", "cell"] = Field(
+        "point",
+        description="the volume change of a point's step: point: each point's own tr(L), the "
+        "paper's eq. 18; cell: the divergence at the centre of the point's grid cell of its "
+        "corner nodes' velocities, shared by the cell's points, and the mean stress's force "
+        "through the same gradient (the Q1P0 element's one volume per cell; the shear stays "
+        "the point's own), explicit USL steps only. With four points per cell each holding "
+        "its own volume a nearly incompressible flow locks, more along the grid than across "
+        "it: a filleted pair's neck grows up to 10 % faster across the diagonal "
+        "(docs/record/verification.md, neck growth at any angle)",
+    )
+    dilatation_mass_floor: float = Field(
+        0.01,
+        ge=0,
+        le=1,
+        description='dilatation = "cell": a node below this fraction of a full cell\'s mass '
+        "keeps m_i / floor of the mean stress's force and hands the rest to its neighbours by "
+        "mass (momentum kept), as the surface force's floor does: the cell's gradient reaches "
+        "corners that a point barely touches",
+    )
     update: Literal["usl", "musl"] = Field(
         "usl",
         description="usl: eqs. 14-17 as printed; musl: move points with the remapped grid "

@@ -280,6 +280,28 @@ class Case(Model):
                 "integrator linearises the surface-energy force only (allowed with it: "
                 '"surface_energy")'
             )
+        if self.solver.dilatation == "cell" and (
+            self.time.integrator != "explicit" or self.solver.update != "usl"
+        ):
+            raise CaseError(
+                f'solver.dilatation = "cell" with time.integrator = {self.time.integrator!r} '
+                f"and solver.update = {self.solver.update!r}: the cells' dilatation is taken on "
+                "explicit USL steps only (the implicit step's tangent is assembled with each "
+                "point's own; MUSL remaps the velocity it is read from); allowed: "
+                'time.integrator = "explicit" with solver.update = "usl", or dilatation = '
+                '"point"'
+            )
+        folded = [
+            w.mechanical
+            for w in self.boundary.walls(self.domain.dim)
+            if w.mechanical in ("mirror", "periodic")
+        ]
+        if self.solver.dilatation == "cell" and folded:
+            raise CaseError(
+                f'solver.dilatation = "cell" with a {folded[0]!r} wall: its pressure force is '
+                "not folded over the wall's images; allowed with it: walls that are not mirror "
+                'or periodic, or dilatation = "point"'
+            )
         if self.time.integrator != "explicit" and self.solver.update != "usl":
             raise CaseError(
                 f"solver.update = {self.solver.update!r}: the implicit integrator moves the "

@@ -22,6 +22,10 @@ damps: a square of Maxwell fluid rounds off more slowly (tests/physics/test_mech
 did not cure the fine-grid scan case's stray point (a filament climbing the left wall), so USL
 stays the default.
 
+Dilatation (``solver.dilatation``): "point" takes each point's own tr(L) (eq. 18); "cell" the
+divergence at the centre of its cell for every point of the cell, and the mean stress's force
+through the same gradient (physics/dilatation.py).
+
 ``cfg`` is the step's compile-time configuration (grid geometry, switches); ``pt`` the points and
 ``nd`` the nodes (struct fields, solver/fields.py).
 """
@@ -29,6 +33,7 @@ stays the default.
 from taichi_sls.backend import ti
 
 from .codes import Transfer, WallMechanical
+from .dilatation import cell_divergence, scatter_pressure_force
 from .grid import node_x, scatter_add
 from .shape import STENCIL_SHAPE, node_weight
 from .small_matrix import IDENTITY, ZERO_MATRIX, ZERO_VECTOR
@@ -59,6 +64,10 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
             sig[a, b] = pt.stress[p][a, b]
         if ti.static(cfg.solvent):
             sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
+        if ti.static(cfg.cell_dilatation):  # the mean stress through the cell's gradient
+            mean_stress = sig.trace() / cfg.dim
+            sig -= mean_stress * ti.Matrix(IDENTITY[cfg.dim])
+            scatter_pressure_force(cfg, nd, xp, Vp, mean_stress)
     g = ti.Vector(cfg.gravity, dt=float)
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
@@ -171,6 +180,9 @@ def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
     Returns the velocity gradient L for the constitutive update.
     """
     v_grid, L = interpolate_velocity(cfg, nd, base, w, dw)
+    if ti.static(cfg.cell_dilatation):  # the cell's dilatation, the point's own shear
+        div = cell_divergence(cfg, nd, pt.x[p])
+        L += (div - L.trace()) / cfg.dim * ti.Matrix(IDENTITY[cfg.dim])
     pt.x[p] += dt * v_grid
     F = (ti.Matrix(IDENTITY[cfg.dim]) + dt * L) @ pt.F[p]
     pt.F[p] = F

@@ -152,18 +152,23 @@ def _spread_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), s
 
 @ti.func
 def _spread_node_at(cfg: ti.template(), nd: ti.template(), I):
-    """Node I's share of :func:`spread_light_nodes`: the rest of its surface force to its
-    3^dim - 1 neighbours, by mass."""
-    f = nd.surface_force[I]
+    """Node I's share of :func:`spread_light_nodes`."""
+    spread_light_node(cfg, nd, I, nd.surface_force[I], cfg.se.floor_mass)
+
+
+@ti.func
+def spread_light_node(cfg: ti.template(), nd: ti.template(), I, f, floor):
+    """Force f of node I into nd.force: whole if the node holds at least ``floor`` (kg), else
+    its share m_i / floor, the rest to its 3^dim - 1 neighbours by mass."""
     m = nd.mass[I]
-    if m >= cfg.se.floor_mass:
+    if m >= floor:
         scatter_add(cfg, nd.force, I, f)
     elif f.norm_sqr() > 0.0:
         M = 0.0
         for o in ti.grouped(ti.ndrange(*NEIGHBOURS[cfg.dim])):  # at run time: one copy
             if (o != 0).any():
                 M += nd.mass[I + o]
-        keep = m / cfg.se.floor_mass
+        keep = m / floor
         if M <= 0.0:
             keep = 1.0
         scatter_add(cfg, nd.force, I, keep * f)

@@ -116,6 +116,7 @@ NODE_MEMBERS = {
     "mass_gradient": "vector",
     "colour": "scalar",
     "surface_force": "vector",
+    "pressure_force": "vector",  # solver.dilatation = "cell": before its mass floor
 }
 
 

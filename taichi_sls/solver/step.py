@@ -33,6 +33,7 @@ from ..physics.beam_surface import column_of, find_column_tops
 from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
+from ..physics.dilatation import pressure_force_floor
 from ..physics.grid import active
 from ..physics.held_temperature import hold_at_table
 from ..physics.level_set import scatter_level_set
@@ -96,6 +97,8 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
         nd.mass[I] = 0.0
         nd.momentum[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         nd.force[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
+        if ti.static(st.cfg.cell_dilatation):
+            nd.pressure_force[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         if ti.static(st.cfg.thermal):
             if heat:
                 nd.heat_capacity[I] = 0.0
@@ -159,6 +162,13 @@ def grid_temperature_stage(st: ti.template(), heat: ti.template(), geom: ti.temp
 def _grid_temperature_loop(st: ti.template()):
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         grid_temperature(st.cfg, st.nodes, I)
+
+
+@ti.func
+def pressure_floor(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """solver.dilatation = "cell": the mean stress's force on the nodes, light ones floored."""
+    if ti.static(st.cfg.cell_dilatation):
+        pressure_force_floor(st.cfg, st.box, st.nodes)
 
 
 @ti.func
@@ -355,6 +365,7 @@ STAGES = (
     clear_grid,
     p2g,
     fold_after_p2g,
+    pressure_floor,
     grid_temperature_stage,
     surface_force,
     heat_flux,

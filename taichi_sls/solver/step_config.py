@@ -85,6 +85,8 @@ class StepConfig:
     transfer: Transfer
     flip_ratio: float
     update: Update
+    cell_dilatation: bool  # solver.dilatation = "cell": the Q1P0 volume of physics/mechanics.py
+    dilatation_floor: float  # kg per depth: the light nodes' floor of its pressure force
     implicit: bool  # time.integrator = "implicit" (solver/implicit.py)
     layout: Layout
     parallel: bool  # one kernel call per step, its loops parallel (not the serial layout)
@@ -246,6 +248,8 @@ def step_config(
         transfer=Transfer[sv.transfer.upper()],
         flip_ratio=flip_share(case, dt),
         update=Update[sv.update.upper()],
+        cell_dilatation=sv.dilatation == "cell",
+        dilatation_floor=sv.dilatation_mass_floor * rho_ref * h**dim,
         implicit=implicit,
         layout=layout,
         parallel=layout != Layout.SERIAL,

@@ -1,0 +1,79 @@
+"""One volume per cell (``solver.dilatation = "cell"``): the Q1P0 element's dilatation.
+
+Each point's own tr(L) (eq. 18 per point) gives four volume constraints a cell, with four points
+per cell, against about two velocity unknowns a node: a nearly incompressible flow locks, and
+more along the grid lines than across the diagonal, so a neck grows faster at 45 deg than along
+x (docs/record/verification.md, "Neck growth at any angle"). Here every point of a cell takes
+the divergence at the cell's centre of the multilinear interpolant of its corner velocities
+(the mean divergence over the cell) for its volume change, its shear its own; the mean stress
+acts through the same gradient, so the internal power is sum_p V_p sigma_p : L_p of the L_p the
+points take. That gradient reaches corners that a point barely touches: a node below
+``solver.dilatation_mass_floor`` of a full cell's mass keeps m_i / floor of this force and hands
+the rest to its neighbours by mass (momentum kept), as the surface force's floor does
+(physics/surface_energy.py).
+
+Arguments: ``cfg`` the step's configuration, ``nd`` the nodes (``v``, ``mass``,
+``pressure_force``, ``force``), ``box`` the active region.
+"""
+
+from taichi_sls.backend import ti
+
+from .grid import active, scatter_add
+from .small_matrix import ZERO_VECTOR
+from .surface_energy import in_passes, spread_light_node
+
+CELL_CORNERS = {dim: (2,) * dim for dim in (2, 3)}  # a cell's corner offsets, by dimension
+
+
+@ti.func
+def point_cell(cfg: ti.template(), xp):
+    """Array index of the lower corner node of the cell that holds x_p (clamped as the point's
+    stencil is, so the corners lie in it)."""
+    c = ti.cast(ti.floor(xp * cfg.inv_h), ti.i32) + cfg.off
+    return ti.max(ti.min(c, ti.Vector([n - 3 for n in cfg.shape])), 1)
+
+
+@ti.func
+def corner_gradient(cfg: ti.template(), o):
+    """grad N at the cell's centre of the multilinear hat of its corner at offset o in
+    {0, 1}^dim: +-1/h times 1/2 per other axis."""
+    g = ti.Vector(ZERO_VECTOR[cfg.dim])
+    for d in ti.static(range(cfg.dim)):
+        g[d] = (2.0 * o[d] - 1.0) * cfg.inv_h * 0.5 ** (cfg.dim - 1)
+    return g
+
+
+@ti.func
+def cell_divergence(cfg: ti.template(), nd: ti.template(), xp):
+    """div v at the centre of the cell that holds x_p, from its corner nodes."""
+    c = point_cell(cfg, xp)
+    div = 0.0
+    for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):  # at run time: one copy
+        div += nd.v[c + o].dot(corner_gradient(cfg, o))
+    return div
+
+
+@ti.func
+def scatter_pressure_force(cfg: ti.template(), nd: ti.template(), xp, V, mean_stress):
+    """-V mean_stress grad N at the centre of x_p's cell, onto its corners (nd.pressure_force,
+    before the floor)."""
+    c = point_cell(cfg, xp)
+    for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
+        scatter_add(cfg, nd.pressure_force, c + o, -V * mean_stress * corner_gradient(cfg, o))
+
+
+@ti.func
+def pressure_force_floor(cfg: ti.template(), box: ti.template(), nd: ti.template()):
+    """nd.pressure_force into nd.force, light nodes' rest spread to their neighbours (module
+    docstring): in 2D in the surface force's race-free passes, in 3D with atomic adds."""
+    if ti.static(cfg.dim == 3):
+        for I in ti.grouped(ti.ndrange(*active(box))):
+            spread_light_node(cfg, nd, I, nd.pressure_force[I], cfg.dilatation_floor)
+    else:
+        in_passes(cfg, box, 0, 3, _floor_node, nd, nd, 0.0)
+
+
+@ti.func
+def _floor_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), scale, i, j):
+    I = ti.Vector([i, j])
+    spread_light_node(cfg, nd, I, nd.pressure_force[I], cfg.dilatation_floor)
