@@ -63,14 +63,25 @@ def scatter_pressure_force(cfg: ti.template(), nd: ti.template(), xp, V, mean_st
 
 
 @ti.func
+def pressure_floor(st: ti.template(), heat: ti.template(), geom: ti.template()):
+    """The step's stage after the P2G (solver/step.py STAGES), with ``dilatation = "cell"``:
+    the mean stress's force on the nodes, light ones floored."""
+    if ti.static(st.cfg.cell_dilatation):
+        pressure_force_floor(st.cfg, st.box, st.nodes)
+
+
+@ti.func
 def pressure_force_floor(cfg: ti.template(), box: ti.template(), nd: ti.template()):
     """nd.pressure_force into nd.force, light nodes' rest spread to their neighbours (module
-    docstring): in 2D in the surface force's race-free passes, in 3D with atomic adds."""
+    docstring): in 2D in the surface force's race-free passes, in 3D with atomic adds. Then
+    nd.pressure_force is zero again for the next step's P2G (it is written nowhere else)."""
     if ti.static(cfg.dim == 3):
         for I in ti.grouped(ti.ndrange(*active(box))):
             spread_light_node(cfg, nd, I, nd.pressure_force[I], cfg.dilatation_floor)
     else:
         in_passes(cfg, box, 0, 3, _floor_node, nd, nd, 0.0)
+    for I in ti.grouped(ti.ndrange(*active(box))):
+        nd.pressure_force[I] = ti.Vector(ZERO_VECTOR[cfg.dim])
 
 
 @ti.func

@@ -2,7 +2,7 @@
 
     clear_grid     over the active region (grown at the end of G2P to hold every point)
     p2g            mass, momentum, forces (eqs. 10-12); heat capacity (eq. 28)*; eq. 21**
-    (fold_after_p2g, and fold_before_update before grid_update: mirror walls, physics/mirror.py)
+    (fold_after_p2g, fold_before_update: mirror walls; pressure_floor: dilatation = "cell")
     grid_temperature  node temperature (fixed-temperature walls)*
     surface_force  level set and curvature (eqs. 21-24)**; grad m, CSF force (eqs. 19-20)
     heat_flux      grad T_p, conduction and laser heat rates (eqs. 29-31)*
@@ -11,15 +11,14 @@
                    strain split and Perzyna return map (eqs. 34-45); the active region grows
     advance_clock  t += dt
 
-``STAGES`` writes this order once; every layout, the implicit step (solver/implicit.py) and the
-grid views (solver/grid_views.py) run it (or a prefix
-of it). Two clocks skip what a step does not need. * Heat runs every ``heat_every`` steps with a
-heat step of heat_every * dt: conduction's stability limit is ~100x the elastic one, and its
-thermal strain increment is spread over the mechanical steps that follow. ** The level set and
-curvature are rebuilt every ``curvature_every`` steps (a fraction of the capillary limit); the
-CSF force is rebuilt from the current mass every step. Each stage takes ``heat`` and ``geom``:
-Python bools in the parallel layout (the stages compile in or out), runtime flags in the serial
-one.
+``STAGES`` writes this order once; every layout, the implicit step (solver/implicit.py) and the grid
+views (solver/grid_views.py) run it (or a prefix of it). Two clocks skip what a step does not need.
+* Heat runs every ``heat_every`` steps with a heat step of heat_every * dt: conduction's stability
+limit is ~100x the elastic one, and its thermal strain increment is spread over the mechanical steps
+that follow. ** The level set and curvature are rebuilt every ``curvature_every`` steps (a fraction
+of the capillary limit); the CSF force is rebuilt from the current mass every step. Each stage takes
+``heat`` and ``geom``: Python bools in the parallel layout (the stages compile in or out), runtime
+flags in the serial one.
 
 Layouts. Serial (CPU, small scenes): many steps inside one kernel call with the step loop
 serialized, since a kernel launch costs tens of microseconds and the paper's scene has a few
@@ -33,7 +32,7 @@ from ..physics.beam_surface import column_of, find_column_tops
 from ..physics.codes import SurfaceMethod, Update
 from ..physics.constitutive import stress_update, thermal_strain_increment, thermal_strain_step
 from ..physics.csf import csf_force, mass_gradient, surface_geometry
-from ..physics.dilatation import pressure_force_floor
+from ..physics.dilatation import pressure_floor
 from ..physics.grid import active
 from ..physics.held_temperature import hold_at_table
 from ..physics.level_set import scatter_level_set
@@ -97,8 +96,6 @@ def clear_grid(st: ti.template(), heat: ti.template(), geom: ti.template()):
         nd.mass[I] = 0.0
         nd.momentum[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         nd.force[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
-        if ti.static(st.cfg.cell_dilatation):
-            nd.pressure_force[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         if ti.static(st.cfg.thermal):
             if heat:
                 nd.heat_capacity[I] = 0.0
@@ -162,13 +159,6 @@ def grid_temperature_stage(st: ti.template(), heat: ti.template(), geom: ti.temp
 def _grid_temperature_loop(st: ti.template()):
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         grid_temperature(st.cfg, st.nodes, I)
-
-
-@ti.func
-def pressure_floor(st: ti.template(), heat: ti.template(), geom: ti.template()):
-    """solver.dilatation = "cell": the mean stress's force on the nodes, light ones floored."""
-    if ti.static(st.cfg.cell_dilatation):
-        pressure_force_floor(st.cfg, st.box, st.nodes)
 
 
 @ti.func
