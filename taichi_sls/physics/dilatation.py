@@ -73,18 +73,22 @@ def pressure_floor(st: ti.template(), heat: ti.template(), geom: ti.template()):
 @ti.func
 def pressure_force_floor(cfg: ti.template(), box: ti.template(), nd: ti.template()):
     """nd.pressure_force into nd.force, light nodes' rest spread to their neighbours (module
-    docstring): in 2D in the surface force's race-free passes, in 3D with atomic adds. Then
-    nd.pressure_force is zero again for the next step's P2G (it is written nowhere else)."""
+    docstring): in 2D in the surface force's race-free passes, in 3D with atomic adds."""
     if ti.static(cfg.dim == 3):
         for I in ti.grouped(ti.ndrange(*active(box))):
-            spread_light_node(cfg, nd, I, nd.pressure_force[I], cfg.dilatation_floor)
+            _floor_at(cfg, nd, I)
     else:
         in_passes(cfg, box, 0, 3, _floor_node, nd, nd, 0.0)
-    for I in ti.grouped(ti.ndrange(*active(box))):
-        nd.pressure_force[I] = ti.Vector(ZERO_VECTOR[cfg.dim])
 
 
 @ti.func
 def _floor_node(cfg: ti.template(), nd: ti.template(), target: ti.template(), scale, i, j):
-    I = ti.Vector([i, j])
+    _floor_at(cfg, nd, ti.Vector([i, j]))  # in_passes' visitor in 2D
+
+
+@ti.func
+def _floor_at(cfg: ti.template(), nd: ti.template(), I):
+    """Node I's pressure force floored into nd.force, then zeroed for the next step's P2G (only
+    this visit reads it; it is written nowhere else)."""
     spread_light_node(cfg, nd, I, nd.pressure_force[I], cfg.dilatation_floor)
+    nd.pressure_force[I] = ti.Vector(ZERO_VECTOR[cfg.dim])

@@ -124,7 +124,7 @@ def angle_trend(rows: list[dict]) -> tuple[float, float]:
     a = np.array([r["angle_deg"] for r in rows]) / 45.0
     g = np.array([r["growth"] for r in rows])
     A = np.stack([np.ones_like(a), a], axis=1)
-    coef, res, *_ = np.linalg.lstsq(A, g, rcond=None)
+    coef = np.linalg.lstsq(A, g, rcond=None)[0]
     dof = max(len(g) - 2, 1)
     sigma2 = float(np.sum((g - A @ coef) ** 2)) / dof
     cov = sigma2 * np.linalg.inv(A.T @ A)
