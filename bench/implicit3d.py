@@ -1,15 +1,20 @@
 """The implicit step in 3D, its cost against the unknowns: ``taichi-sls bench implicit3d
-[--quick] [--steps N] [--out renders]``.
+[--quick] [--steps N] [--dt S] [--solvers ...] [--spacings ...] [--out renders]``.
 
 Two molten PA12 spheres, R = 20 um, touching at a point in a 120 x 60 x 60 um box (surface
-tension on, no gravity), implicit steps at the "auto" step, at h = 4, 3 and 2.5 um (``--quick``:
-4 only), each with the direct solver (CHOLMOD) and with AMG-CG (pyamg's smoothed aggregation
-with the rigid-body modes), the direct one also with the rows stored by blocks
-(``time.implicit_rows = "blocks"``) beside dense ones. After one step (which compiles),
+tension on, no gravity), implicit steps at the "auto" step (``--dt``: a fixed one; 1e-2 is a
+layer's hold, where the viscous stiffness outweighs the inertia 1e8 times), at h = 4, 3 and
+2.5 um (``--quick``: 4 only), each with the direct solver (CHOLMOD), AMG-CG (pyamg's smoothed
+aggregation with the rigid-body modes) and the matrix-free step (CG with the grid multigrid,
+solver/multigrid.py), the direct one also with the rows stored by blocks
+(``time.implicit_rows = "blocks"``) beside dense ones. The process material
+(``pa12_process``) with ``--dt``, the paper's PA12 without. After one step (which compiles),
 ``--steps`` steps are timed: the wall time per step and per Newton linear solve, Newton
 iterations, CG iterations per solve (0: the factorization alone), the unknowns, and the
 implicit grid fields' memory (the rows in the blocks they were written in, the rest over the
-grid) per grid node, per active node (one with unknowns) and per point.
+grid) per grid node, per active node (one with unknowns) and per point, and the host's arrays
+of the last step per point (the fixed part's gathered rows and CSR matrix, the assembled
+tangent or the multigrid's levels).
 Writes ``implicit3d.csv`` and ``implicit3d.json`` and prints the table (docs/record/implicit.md, "In
 3D")."""
 
@@ -24,6 +29,7 @@ from taichi_sls.config import case_from_dict
 from taichi_sls.io.atomic import atomic_write_text, write_rows
 from taichi_sls.solver import linear_solve
 from taichi_sls.solver.implicit import allocated_row_nodes
+from taichi_sls.solver.multigrid import MatrixFreeSolver
 from taichi_sls.solver.simulation import Simulation
 
 SPACINGS_UM = (4.0, 3.0, 2.5)
@@ -42,12 +48,14 @@ COLUMNS = [
     "bytes_per_node",
     "bytes_per_active_node",
     "bytes_per_point",
+    "host_bytes_per_point",
 ]
+SOLVERS = ("direct", "direct-blocks", "amg", "matrix_free")
 
 
-def pair_case(h_um: float, solver: str, rows: str = "dense") -> dict:
+def pair_case(h_um: float, solver: str, rows: str = "dense", dt_s: float | None = None) -> dict:
     """The sphere pair at spacing h_um with time.linear_solver = solver and time.implicit_rows
-    = rows."""
+    = rows; ``dt_s``: a fixed step, with the process material."""
     spheres = [
         {"center_um": [x, 30.0, 30.0], "radius_um": 20.0, "temperature_C": 200.0}
         for x in (40.0, 80.0)
@@ -57,14 +65,14 @@ def pair_case(h_um: float, solver: str, rows: str = "dense") -> dict:
         "domain": {"dim": 3, "width_um": 120.0, "height_um": 60.0, "depth_um": 60.0},
         "bodies": spheres,
         "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0, 0.0]},
-        "time": {
-            "integrator": "implicit",
-            "linear_solver": solver,
-            "implicit_rows": rows,
-            "end_s": 1.0,
-        },
+        "time": _time(solver, rows),
         "output": {"frames": 1},
-    }
+        **({"materials": {"PA12": {"preset": "pa12_process"}}} if dt_s else {}),
+    } | ({} if dt_s is None else {"time": {**_time(solver, rows), "dt_s": dt_s}})
+
+
+def _time(solver: str, rows: str) -> dict:
+    return {"integrator": "implicit", "linear_solver": solver, "implicit_rows": rows, "end_s": 1.0}
 
 
 def _grid_bytes(sim: Simulation) -> int:
@@ -82,21 +90,30 @@ def _grid_nodes(sim: Simulation) -> int:
     return int(np.prod(sim.state.implicit.free.shape))
 
 
-def measure(h_um: float, solver: str, steps: int, rows: str = "dense") -> dict:
-    sim = Simulation(case_from_dict(pair_case(h_um, solver, rows)))
+def measure(
+    h_um: float, solver: str, steps: int, rows: str = "dense", dt_s: float | None = None
+) -> dict:
+    sim = Simulation(case_from_dict(pair_case(h_um, solver, rows, dt_s)))
     sim.advance_to(sim.dt)  # one step: compiles the step's kernels
     spent = {"s": 0.0, "n": 0}
-    solve = linear_solve.LinearSolver.solve
+    kinds = (linear_solve.LinearSolver, MatrixFreeSolver)
+    solves = [k.solve for k in kinds]
+    host = {"bytes": 0}
 
-    def timed(self, A, b, refresh=False):
-        t0 = time.perf_counter()
-        try:
-            return solve(self, A, b, refresh)
-        finally:
-            spent["s"] += time.perf_counter() - t0
-            spent["n"] += 1
+    def timed(solve):
+        def run(self, A, b, refresh=False):
+            t0 = time.perf_counter()
+            try:
+                return solve(self, A, b, refresh)
+            finally:
+                spent["s"] += time.perf_counter() - t0
+                spent["n"] += 1
+                host["bytes"] = max(host["bytes"], _host_bytes(sim, A))
 
-    linear_solve.LinearSolver.solve = timed
+        return run
+
+    for kind, solve in zip(kinds, solves, strict=True):
+        kind.solve = timed(solve)
     try:
         newton0 = sim.implicit.newton_total
         cg0 = sim.implicit.linear.stats.cg_iterations
@@ -104,7 +121,8 @@ def measure(h_um: float, solver: str, steps: int, rows: str = "dense") -> dict:
         sim.advance_to(sim.t + steps * sim.dt)
         wall = time.perf_counter() - t0
     finally:
-        linear_solve.LinearSolver.solve = solve
+        for kind, solve in zip(kinds, solves, strict=True):
+            kind.solve = solve
     dim = sim.state.cfg.dim
     grid = _grid_bytes(sim)
     nodes = _grid_nodes(sim)
@@ -127,7 +145,18 @@ def measure(h_um: float, solver: str, steps: int, rows: str = "dense") -> dict:
         "bytes_per_node": round(grid / nodes),
         "bytes_per_active_node": round(grid / max(active, 1)),
         "bytes_per_point": round(grid / sim.scene.n_points),
+        "host_bytes_per_point": round(host["bytes"] / sim.scene.n_points),
     }
+
+
+def _host_bytes(sim: Simulation, A) -> int:
+    """The host's arrays of the step being solved: the Newton matrix (assembled) or the
+    multigrid's levels and the fixed part's CSR matrix (matrix-free), and the point moduli."""
+    linear = sim.implicit.linear
+    if isinstance(linear, MatrixFreeSolver):
+        F = linear.multigrid.fixed
+        return linear.multigrid.nbytes + F.data.nbytes + F.indices.nbytes + F.indptr.nbytes
+    return A.data.nbytes + A.indices.nbytes + A.indptr.nbytes
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -135,6 +164,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap.add_argument("--out", default="renders", help="folder for implicit3d.csv and .json")
     ap.add_argument("--quick", action="store_true", help="h = 4 um only")
     ap.add_argument("--steps", type=int, default=3, help="timed steps per row")
+    ap.add_argument("--dt", type=float, default=None, help="a fixed step (s); default auto")
+    ap.add_argument("--solvers", nargs="+", choices=SOLVERS, default=list(SOLVERS))
+    ap.add_argument("--spacings", nargs="+", type=float, default=None, help="h (um)")
     ap.set_defaults(func=main)
 
 
@@ -142,9 +174,11 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
-    for h in SPACINGS_UM[:1] if args.quick else SPACINGS_UM:
-        for solver, storage in (("direct", "dense"), ("direct", "blocks"), ("amg", "dense")):
-            rows.append(measure(h, solver, args.steps, storage))
+    spacings = args.spacings or (SPACINGS_UM[:1] if args.quick else SPACINGS_UM)
+    for h in spacings:
+        for name in args.solvers:
+            solver, _, storage = name.partition("-")
+            rows.append(measure(h, solver, args.steps, storage or "dense", args.dt))
             r = rows[-1]
             print(
                 f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['rows']:6s} "
@@ -153,7 +187,7 @@ def main(args: argparse.Namespace) -> int:
                 f"{r['newton_iterations_per_step']:5.2f} Newton/step "
                 f"{r['cg_iterations_per_solve']:5.1f} CG/solve  "
                 f"{r['bytes_per_node']} B/node {r['bytes_per_active_node']} B/active node "
-                f"{r['bytes_per_point']} B/point",
+                f"{r['bytes_per_point']} B/point {r['host_bytes_per_point']} B/point on the host",
                 flush=True,
             )
     write_rows(out / "implicit3d.csv", rows, COLUMNS)

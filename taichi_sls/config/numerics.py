@@ -147,12 +147,14 @@ class Time(Model):
         "fixes, against runaway velocities (docs/record/implicit.md); 1e-6 steadies hopper_pa12 at "
         "R0/h = 20 and time.newton_tolerance = 1e-8",
     )
-    linear_solver: Literal["auto", "direct", "amg"] = Field(
+    linear_solver: Literal["auto", "direct", "amg", "matrix_free"] = Field(
         "auto",
         description="implicit: direct (CHOLMOD's Cholesky through cvxopt; qdldl's LDL^T where "
         "a matrix is not positive definite), amg (conjugate gradients "
-        "preconditioned by pyamg's smoothed aggregation) or auto (direct up to "
-        "direct_max_unknowns grid velocity components, amg above)",
+        "preconditioned by pyamg's smoothed aggregation), matrix_free (conjugate gradients "
+        "on the points' tangent applied through the points, no assembled tangent, "
+        "preconditioned by a geometric multigrid on the MPM grid: solver/multigrid.py) or "
+        "auto (direct up to direct_max_unknowns grid velocity components, amg above)",
     )
     direct_max_unknowns: int | None = Field(
         None,
@@ -216,13 +218,25 @@ class Time(Model):
         description="adaptive: the largest strain increment of any point in one step (the "
         "measure: strain_control)",
     )
-    strain_control: Literal["total", "plastic"] = Field(
+    strain_control: Literal["total", "plastic", "error"] = Field(
         "total",
         description="adaptive: total: the Frobenius norm of f - I, f = F^{n+1} (F^n)^-1 the "
         "step's deformation gradient; plastic: the equivalent plastic (viscous) strain "
         "increment, the only part of the strain whose path a step's size changes: an elastic "
         "jump (two melt surfaces snapping into contact) reaches the same quasi-static state at "
-        "any step, and the total measure chased it down to the explicit step (docs/record/beds.md)",
+        "any step, and the total measure chased it down to the explicit step "
+        "(docs/record/beds.md); error: no strain increment, the motion's local error instead "
+        "(max_position_error_cells)",
+    )
+    max_position_error_cells: float = Field(
+        0.01,
+        gt=0,
+        lt=0.5,
+        description='adaptive, strain_control = "error": the largest local error of a flowing '
+        "point's position in one step (one whose plastic strain grew), in cells, estimated as "
+        "backward Euler's dt |v^{n+1} - v^n| / 2 (the step's motion against a step at the "
+        "velocity it started with): the steps a viscous flow's accuracy needs, long where the "
+        "flow is steady (docs/record/implicit.md)",
     )
 
 

@@ -51,6 +51,7 @@ class StepControls:
     strain: float
     cells: float
     plastic: bool = False  # the strain control reads the plastic increment, not the total
+    position_error: float = 0.0  # > 0: the motion's local error (cells) replaces the strain
 
     @classmethod
     def from_case(cls, case: Case, dt0: float, floor: float | None = None) -> "StepControls":
@@ -66,6 +67,7 @@ class StepControls:
             t.max_strain_increment,
             t.max_motion_cells,
             t.strain_control == "plastic",
+            t.max_position_error_cells if t.strain_control == "error" else 0.0,
         )
 
 
@@ -112,13 +114,16 @@ def points_pass(
     now: ti.template(), before: ti.template(), out: ti.template(), dt: float, what: ti.i32
 ):
     """As ``what`` (:class:`PointsPass`) says: save the points, put them back, or out = (dT,
-    de, dx, dp): the largest temperature change (K), strain increment |F F_before^-1 - I|
-    (Frobenius), motion (m) and equivalent plastic strain increment of any point over the step
-    dt since ``before``; the motion also as the point's own velocity times dt, which the guard
-    limits (with FLIP it is not the grid velocity that moved the point). One kernel for the
-    three (a kernel's compilation costs tens of ms whatever its size)."""
+    de, dx, dp, ex): the largest temperature change (K), strain increment |F F_before^-1 - I|
+    (Frobenius), motion (m), equivalent plastic strain increment and local position error
+    dt |v - v_before| / 2 (m; backward Euler's against the step at the velocity it started
+    with; of the points whose plastic strain grew: the flow, not an elastic point's
+    quasi-static jump) of any point over the step dt since ``before``; the motion also as the
+    point's own velocity times dt, which the guard limits (with FLIP it is not the grid
+    velocity that moved the point). One kernel for the three (a kernel's compilation costs
+    tens of ms whatever its size)."""
     if what == PointsPass.CHANGES:
-        out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
     for p in now:
         if what == PointsPass.SAVE:
             before[p] = now[p]
@@ -133,6 +138,8 @@ def points_pass(
             ti.atomic_max(out[None][2], dx)
             dp = now[p].equivalent_plastic_strain - before[p].equivalent_plastic_strain
             ti.atomic_max(out[None][3], dp)
+            if dp > 0.0:  # a point that flows: an elastic one's jump is quasi-static
+                ti.atomic_max(out[None][4], 0.5 * dt * (now[p].v - before[p].v).norm())
 
 
 class AdaptiveStepper:
@@ -163,7 +170,7 @@ class AdaptiveStepper:
         self.before = struct_type(POINT_MEMBERS, st.cfg.dim).field(
             shape=st.n_points, layout=ti.Layout.SOA
         )
-        self.changes = ti.Vector.field(4, float, ())
+        self.changes = ti.Vector.field(5, float, ())
 
     def compile(self) -> None:
         """Compile the implicit step's kernels, those that judge a step (they change nothing
@@ -193,12 +200,17 @@ class AdaptiveStepper:
 
     def changes_ratio(self, dt: float) -> float:
         """The changes of the points since :attr:`before` (over dt), as a multiple of the
-        controls: the largest of dT / dT_max, de / de_max and dx / (cells h)."""
+        controls: the largest of dT / dT_max, de / de_max (or the position error's ratio) and
+        dx / (cells h). The position error grows as dt^2: its square root, so that the next
+        step follows from it as from the others."""
         self.points_pass(PointsPass.CHANGES, dt)
-        dT, de, dx, dp = (float(x) for x in self.changes[None])
-        c = self.controls
-        strain = dp if c.plastic else de
-        return max(dT / c.temperature_K, strain / c.strain, dx / (c.cells * self.st.cfg.h))
+        dT, de, dx, dp, ex = (float(x) for x in self.changes[None])
+        c, h = self.controls, self.st.cfg.h
+        if c.position_error > 0.0:
+            strain = math.sqrt(ex / (c.position_error * h))
+        else:
+            strain = (dp if c.plastic else de) / c.strain
+        return max(dT / c.temperature_K, strain, dx / (c.cells * h))
 
     def step(self, t_end: float = math.inf) -> bool:
         """One accepted step (redoing refused ones), at most up to ``t_end``; none, and False,
@@ -221,10 +233,11 @@ class AdaptiveStepper:
                 continue
             ratio = self.changes_ratio(dt)
             if ratio > REDO and dt > self.controls.dt_min:
-                dT, de, dx, dp = (float(x) for x in self.changes[None])
+                dT, de, dx, dp, ex = (float(x) for x in self.changes[None])
                 why = (
                     f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g}, "
-                    f"plastic strain {dp:.3g}, motion {dx / st.cfg.h:.3g} cells)"
+                    f"plastic strain {dp:.3g}, motion {dx / st.cfg.h:.3g} cells, position "
+                    f"error {ex / st.cfg.h:.3g} cells)"
                 )
                 self._redo(before, dt, next_step(dt, ratio, self.controls), why)
                 continue

@@ -183,7 +183,12 @@ class ImplicitFields:
         # 3D, time.implicit_rows: the rows by blocks of nodes that the step writes
         # (solver/implicit.py clear_rows empties them)
         self.fixed = row_field(grid, (WIDTH,) * cfg.dim, cfg.sparse_rows)
-        self.tangent = row_field(grid, (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim), cfg.sparse_rows)
+        if cfg.matrix_free:  # the tangent is applied through the points (solver/multigrid.py)
+            self.tangent = ti.field(float, (1,) * (2 * cfg.dim + 2))
+            # each point's tangent, (V, a_lambda, a_mu) (physics/tangent_operator.py)
+            self.moduli = ti.Vector.field(3, float, cfg.n_points)
+        else:
+            self.tangent = row_field(grid, (WIDTH,) * cfg.dim + (cfg.dim, cfg.dim), cfg.sparse_rows)
         self.internal = ti.Vector.field(cfg.dim, float, grid)
         self.with_tangent = ti.field(ti.i32, ())  # internal_force assembles the tangent too
         # which nodes are unknowns and their numbers, one struct: the host reads the kinds and

@@ -33,6 +33,7 @@ conjugate gradients over the next iterations and steps. The matrix is symmetric 
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from taichi_sls.backend import ti
 
@@ -57,6 +58,7 @@ from .implicit_heat import StepHeat
 from .implicit_system import GridSystem, Part, dof_index, gather
 from .linear_solve import LinearSolveError, LinearSolver, linear_solver
 from .loops import check_block, grow_box, in_order, point_loop, point_stencil
+from .multigrid import MatrixFreeSolver
 from .step import (
     advance_clock,
     clear_grid,
@@ -183,7 +185,10 @@ def _point_force(st: ti.template(), p):
 def _force_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.template()):
     base, w, dw, V, a_lam, a_mu = _point_force(st, p)
     if st.implicit.with_tangent[None]:
-        scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
+        if ti.static(st.cfg.matrix_free):  # kept per point, applied by solver/multigrid.py
+            st.implicit.moduli[p] = ti.Vector([V, a_lam, a_mu])
+        else:
+            scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
 
 
 @ti.kernel
@@ -203,7 +208,7 @@ def internal_force(st: ti.template(), v: ti.types.ndarray(), dof_node: ti.types.
 def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()):
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        if ti.static(not st.cfg.sparse_rows):
+        if ti.static(not st.cfg.sparse_rows and not st.cfg.matrix_free):
             if st.implicit.with_tangent[None]:
                 _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
         st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
@@ -324,12 +329,14 @@ class ImplicitStepper:
         entries."""
         st = self.st
         st.implicit.with_tangent[None] = int(tangent)
-        if tangent and st.cfg.sparse_rows:
+        if tangent and st.cfg.sparse_rows and not st.cfg.matrix_free:
             clear_rows(st.implicit.tangent)
+        if tangent and st.cfg.matrix_free:
+            st.implicit.moduli.fill(0.0)  # a point the force pass skips adds no tangent
         internal_force(st, v, sys_.dof_node)
         f_int = np.empty(sys_.n)
         cols = np.empty((1, 1), dtype=np.int32)  # not written
-        if not tangent:
+        if not tangent or st.cfg.matrix_free:
             gather(st, sys_.dof_node, cols, np.empty((1, 1)), f_int, f_int, Part.FORCE)
             return f_int, None
         vals = np.empty((sys_.n, self._slots))
@@ -352,16 +359,18 @@ class ImplicitStepper:
         then costs one factorization and one point pass of the tangent per step."""
         st = self.st
         how = linear_solver(self.case, sys_.n)
-        if self.linear is None or self.linear.how != how:
+        if how == "matrix_free":
+            self.linear = MatrixFreeSolver.for_step(self.linear, st, sys_, self.penalty)
+        elif self.linear is None or self.linear.how != how:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
             self.linear.near_null = sys_.rigid_body_modes()
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
-        if self.penalty > 0.0:  # the light nodes' near-null modes (module docstring)
+        if self.penalty > 0.0 and how != "matrix_free":  # the light nodes' near-null modes
             stiffest = np.abs(sys_.fixed + tangent)[sys_.diagonal].max()
             sys_.add_to_fixed(self.penalty * stiffest * sys_.second_differences())
-        A = sys_.matrix(sys_.fixed + tangent)
+        A = self._newton_matrix(sys_, tangent)
         R, scale = self.residual(sys_, v, f_int)
         it, fresh = 0, True
         where = f"implicit step {int(st.scalars.step[None])} (t = {st.scalars.t[None]:.4g} s)"
@@ -397,7 +406,15 @@ class ImplicitStepper:
             slow = alpha < 1.0 or np.linalg.norm(R) > SLOW_CONTRACTION * norm0
             if slow and not np.linalg.norm(R) <= self.tol * scale:
                 f_int, tangent = self.internal(sys_, v)
-                A, fresh = sys_.matrix(sys_.fixed + tangent), True
+                A, fresh = self._newton_matrix(sys_, tangent), True
         self.newton_total += it
         self.last = StepReport(it, sys_.n, float(np.linalg.norm(R) / scale), how)
         return v
+
+    def _newton_matrix(self, sys_: GridSystem, tangent: np.ndarray | None) -> sp.csr_matrix | None:
+        """The Newton matrix of the tangent just taken: assembled, or (matrix-free) None, the
+        multigrid taking the points' moduli instead."""
+        if tangent is None:
+            self.linear.set_tangent()
+            return None
+        return sys_.matrix(sys_.fixed + tangent)

@@ -73,7 +73,7 @@ def gather(
                         if part == Part.FIXED:
                             if a == b:  # a scalar times the identity (ImplicitFields)
                                 value = st.implicit.fixed[I, o]
-                        else:
+                        elif ti.static(not st.cfg.matrix_free):
                             value = st.implicit.tangent[I, o, a, b]
                     vals[k, slot] = value
                     if part == Part.FIXED:

@@ -105,6 +105,7 @@ class StepConfig:
     subgrid_rate: float  # its rate (1/s): chi = 1 - exp(-rate dt_heat) for a varying heat step
     heat_implicit: bool  # time.heat_integrator = "implicit" (solver/implicit_heat.py)
     sparse_rows: bool  # time.implicit_rows: the 3D rows by blocks (solver/fields.py row_field)
+    matrix_free: bool  # time.linear_solver = "matrix_free": no tangent rows (solver/multigrid.py)
     top_loss: bool  # thermal.top_surface = "chamber" (physics/thermal.py)
     chamber_T: float  # K
     emissivity: float
@@ -277,6 +278,7 @@ def step_config(
         subgrid_rate=case.thermal.subgrid_filter / filter_limit if thermal else 0.0,
         heat_implicit=case.implicit_heat(),
         sparse_rows=sparse_rows(case, (scene.nx, scene.ny, scene.nz)[: case.domain.dim]),
+        matrix_free=implicit and case.time.linear_solver == "matrix_free",
         top_loss=thermal and case.thermal.top_surface == "chamber",
         chamber_T=case.thermal.chamber_temperature_C() + KELVIN,
         emissivity=case.thermal.emissivity,

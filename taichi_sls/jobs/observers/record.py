@@ -17,6 +17,22 @@ def _counts(sim: Simulation) -> dict[str, int]:
     }
 
 
+def linear_solves(sim: Simulation) -> dict[str, Any]:
+    """The implicit steps' solves since the run (or its resume) started: the linear solver of
+    the last step (time.linear_solver), Newton iterations, linear solves, factorizations (or
+    multigrid set-ups), conjugate-gradient iterations and the last step's relative residual."""
+    imp = sim.implicit
+    stats = getattr(imp.linear, "stats", None)
+    return {
+        "solver": imp.last.solver or None,
+        "newton_iterations": int(imp.newton_total),
+        "solves": stats.solves if stats is not None else 0,
+        "factorizations": stats.factorizations if stats is not None else 0,
+        "cg_iterations": stats.cg_iterations if stats is not None else 0,
+        "last_residual": float(imp.last.residual),
+    }
+
+
 class Record(Observer):
     """``initial``, ``final``, ``settle``, the step counts and the integrator's counts."""
 
@@ -50,6 +66,8 @@ class Record(Observer):
             s.update(initial=self.initial, final=self.last)
         s.update(steps=sim.steps, simulated_s=sim.t)
         s.update(self.counts(sim))
+        if sim.implicit is not None:
+            s["linear_solves"] = linear_solves(sim)
         s.update(
             handover_s=sim.handover.at_s if sim.handover is not None else None,
             handbacks=sim.handover.handbacks if sim.handover is not None else 0,
