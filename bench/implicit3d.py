@@ -28,7 +28,7 @@ import numpy as np
 from taichi_sls.config import case_from_dict
 from taichi_sls.io.atomic import atomic_write_text, write_rows
 from taichi_sls.solver import linear_solve
-from taichi_sls.solver.implicit import allocated_row_nodes
+from taichi_sls.solver.fields import allocated_row_nodes
 from taichi_sls.solver.multigrid import MatrixFreeSolver
 from taichi_sls.solver.simulation import Simulation
 

@@ -225,18 +225,17 @@ class Time(Model):
         "increment, the only part of the strain whose path a step's size changes: an elastic "
         "jump (two melt surfaces snapping into contact) reaches the same quasi-static state at "
         "any step, and the total measure chased it down to the explicit step "
-        "(docs/record/beds.md); error: no strain increment, the motion's local error instead "
-        "(max_position_error_cells)",
+        "(docs/record/beds.md); error: the plastic strain's local error instead of its "
+        "increment (max_strain_error)",
     )
-    max_position_error_cells: float = Field(
-        0.01,
+    max_strain_error: float = Field(
+        2e-3,
         gt=0,
-        lt=0.5,
-        description='adaptive, strain_control = "error": the largest local error of a flowing '
-        "point's position in one step (one whose plastic strain grew), in cells, estimated as "
-        "backward Euler's dt |v^{n+1} - v^n| / 2 (the step's motion against a step at the "
-        "velocity it started with): the steps a viscous flow's accuracy needs, long where the "
-        "flow is steady (docs/record/implicit.md)",
+        description='adaptive, strain_control = "error": the largest local error of a point\'s '
+        "equivalent plastic (viscous) strain in one step, estimated as backward Euler's "
+        "dt |r^{n+1} - r^n| / 2, r the point's plastic strain rate over a step (the step against "
+        "one at the rate the last step took): the steps a viscous flow's accuracy needs, long "
+        "where the flow is steady; an elastic jump has no plastic rate (docs/record/implicit.md)",
     )
 
 

@@ -51,7 +51,7 @@ class StepControls:
     strain: float
     cells: float
     plastic: bool = False  # the strain control reads the plastic increment, not the total
-    position_error: float = 0.0  # > 0: the motion's local error (cells) replaces the strain
+    strain_error: float = 0.0  # > 0: the plastic strain's local error replaces its increment
 
     @classmethod
     def from_case(cls, case: Case, dt0: float, floor: float | None = None) -> "StepControls":
@@ -67,7 +67,7 @@ class StepControls:
             t.max_strain_increment,
             t.max_motion_cells,
             t.strain_control == "plastic",
-            t.max_position_error_cells if t.strain_control == "error" else 0.0,
+            t.max_strain_error if t.strain_control == "error" else 0.0,
         )
 
 
@@ -107,21 +107,26 @@ class PointsPass(enum.IntEnum):
     SAVE = 0  # before = now
     RESTORE = 1  # now = before
     CHANGES = 2  # the step's changes, :func:`points_pass`
+    ACCEPT = 3  # the step's plastic rates become the last step's
 
 
 @ti.kernel
 def points_pass(
-    now: ti.template(), before: ti.template(), out: ti.template(), dt: float, what: ti.i32
+    now: ti.template(),
+    before: ti.template(),
+    rates: ti.template(),
+    out: ti.template(),
+    dt: float,
+    what: ti.i32,
 ):
     """As ``what`` (:class:`PointsPass`) says: save the points, put them back, or out = (dT,
-    de, dx, dp, ex): the largest temperature change (K), strain increment |F F_before^-1 - I|
-    (Frobenius), motion (m), equivalent plastic strain increment and local position error
-    dt |v - v_before| / 2 (m; backward Euler's against the step at the velocity it started
-    with; of the points whose plastic strain grew: the flow, not an elastic point's
-    quasi-static jump) of any point over the step dt since ``before``; the motion also as the
-    point's own velocity times dt, which the guard limits (with FLIP it is not the grid
-    velocity that moved the point). One kernel for the three (a kernel's compilation costs
-    tens of ms whatever its size)."""
+    de, dx, dp, ep): the largest temperature change (K), strain increment |F F_before^-1 - I|
+    (Frobenius), motion (m), equivalent plastic strain increment and its local error
+    dt |r - r_last| / 2 (backward Euler's against a step at the plastic rate the last step
+    took, r_last = ``rates[p, 0]``; the step's rate r goes to ``rates[p, 1]``) of any point
+    over the step dt since ``before``; the motion also as the point's own velocity times dt,
+    which the guard limits (with FLIP it is not the grid velocity that moved the point). One
+    kernel for the three (a kernel's compilation costs tens of ms whatever its size)."""
     if what == PointsPass.CHANGES:
         out[None] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
     for p in now:
@@ -129,6 +134,8 @@ def points_pass(
             before[p] = now[p]
         elif what == PointsPass.RESTORE:
             now[p] = before[p]
+        elif what == PointsPass.ACCEPT:
+            rates[p][0] = rates[p][1]
         else:
             f = now[p].F @ before[p].F.inverse()
             f -= ti.Matrix(IDENTITY[f.n])
@@ -138,8 +145,8 @@ def points_pass(
             ti.atomic_max(out[None][2], dx)
             dp = now[p].equivalent_plastic_strain - before[p].equivalent_plastic_strain
             ti.atomic_max(out[None][3], dp)
-            if dp > 0.0:  # a point that flows: an elastic one's jump is quasi-static
-                ti.atomic_max(out[None][4], 0.5 * dt * (now[p].v - before[p].v).norm())
+            rates[p][1] = dp / dt
+            ti.atomic_max(out[None][4], 0.5 * ti.abs(dp - dt * rates[p][0]))
 
 
 class AdaptiveStepper:
@@ -171,6 +178,9 @@ class AdaptiveStepper:
             shape=st.n_points, layout=ti.Layout.SOA
         )
         self.changes = ti.Vector.field(5, float, ())
+        # each point's plastic strain rate over the last accepted step and over the one being
+        # judged (1/s): the strain error's estimate (points_pass)
+        self.rates = ti.Vector.field(2, float, st.n_points)
 
     def compile(self) -> None:
         """Compile the implicit step's kernels, those that judge a step (they change nothing
@@ -182,7 +192,7 @@ class AdaptiveStepper:
         self.changes_ratio(self.dt)
 
     def points_pass(self, what: PointsPass, dt: float = 0.0) -> None:
-        points_pass(self.st.points, self.before, self.changes, dt, what)
+        points_pass(self.st.points, self.before, self.rates, self.changes, dt, what)
 
     def save(self) -> None:
         """Keep the points as they are (:attr:`before`)."""
@@ -200,14 +210,14 @@ class AdaptiveStepper:
 
     def changes_ratio(self, dt: float) -> float:
         """The changes of the points since :attr:`before` (over dt), as a multiple of the
-        controls: the largest of dT / dT_max, de / de_max (or the position error's ratio) and
-        dx / (cells h). The position error grows as dt^2: its square root, so that the next
-        step follows from it as from the others."""
+        controls: the largest of dT / dT_max, de / de_max (or the strain error's ratio) and
+        dx / (cells h). The strain error grows as dt^2: its square root, so that the next step
+        follows from it as from the others."""
         self.points_pass(PointsPass.CHANGES, dt)
-        dT, de, dx, dp, ex = (float(x) for x in self.changes[None])
+        dT, de, dx, dp, ep = (float(x) for x in self.changes[None])
         c, h = self.controls, self.st.cfg.h
-        if c.position_error > 0.0:
-            strain = math.sqrt(ex / (c.position_error * h))
+        if c.strain_error > 0.0:
+            strain = math.sqrt(ep / c.strain_error)
         else:
             strain = (dp if c.plastic else de) / c.strain
         return max(dT / c.temperature_K, strain, dx / (c.cells * h))
@@ -233,15 +243,17 @@ class AdaptiveStepper:
                 continue
             ratio = self.changes_ratio(dt)
             if ratio > REDO and dt > self.controls.dt_min:
-                dT, de, dx, dp, ex = (float(x) for x in self.changes[None])
+                dT, de, dx, dp, ep = (float(x) for x in self.changes[None])
                 why = (
                     f"changes {ratio:.2g} x the controls (dT {dT:.3g} K, strain {de:.3g}, "
-                    f"plastic strain {dp:.3g}, motion {dx / st.cfg.h:.3g} cells, position "
-                    f"error {ex / st.cfg.h:.3g} cells)"
+                    f"plastic strain {dp:.3g} (error {ep:.3g}), motion {dx / st.cfg.h:.3g} "
+                    "cells)"
                 )
                 self._redo(before, dt, next_step(dt, ratio, self.controls), why)
                 continue
             self.last_dt = dt
+            if self.controls.strain_error > 0.0:
+                self.points_pass(PointsPass.ACCEPT)
             if not (cut and ratio <= 1.0):
                 self.dt = next_step(dt, ratio, self.controls)
             return True

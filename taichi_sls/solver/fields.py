@@ -168,6 +168,28 @@ def row_field(grid: tuple[int, ...], row: tuple[int, ...], sparse: bool) -> ti.F
     return f
 
 
+def allocated_row_nodes(K, dim: int) -> int:
+    """How many grid nodes a row field holds storage for: all of them when dense, those of
+    the blocks written so far when sparse (their bytes: this times the row's)."""
+    return int(_count_allocated(K)) // int(np.prod(K.shape[dim:]))
+
+
+@ti.kernel
+def _count_allocated(K: ti.template()) -> ti.i64:
+    n = ti.i64(0)
+    for _ in ti.grouped(K):
+        n += 1
+    return n
+
+
+@ti.kernel
+def clear_rows(K: ti.template()):
+    """Zero the allocated blocks of a sparse row field (solver/fields.py ``row_field``): a
+    struct-for visits only those, where the dense rows are cleared node by node over the box."""
+    for idx in ti.grouped(K):
+        K[idx] = 0.0
+
+
 @ti.data_oriented
 class ImplicitFields:
     """The implicit step's grid data (solver/implicit.py, physics/stiffness.py): the fixed part
@@ -181,7 +203,7 @@ class ImplicitFields:
         grid = tuple(cfg.shape)
         row = grid + (WIDTH,) * cfg.dim
         # 3D, time.implicit_rows: the rows by blocks of nodes that the step writes
-        # (solver/implicit.py clear_rows empties them)
+        # (clear_rows below empties them)
         self.fixed = row_field(grid, (WIDTH,) * cfg.dim, cfg.sparse_rows)
         if cfg.matrix_free:  # the tangent is applied through the points (solver/multigrid.py)
             self.tangent = ti.field(float, (1,) * (2 * cfg.dim + 2))

@@ -52,7 +52,7 @@ from ..physics.stiffness import (
     stencil_offset,
 )
 from . import checkpoint, struct_copy
-from .fields import State
+from .fields import State, clear_rows
 from .guard import SimulationError
 from .implicit_heat import StepHeat
 from .implicit_system import GridSystem, Part, dof_index, gather
@@ -113,28 +113,6 @@ def begin(st: State) -> None:
     if st.cfg.sparse_rows:
         clear_rows(st.implicit.fixed)
     in_order(st, _begin)
-
-
-def allocated_row_nodes(K, dim: int) -> int:
-    """How many grid nodes a row field holds storage for: all of them when dense, those of
-    the blocks written so far when sparse (their bytes: this times the row's)."""
-    return int(_count_allocated(K)) // int(np.prod(K.shape[dim:]))
-
-
-@ti.kernel
-def _count_allocated(K: ti.template()) -> ti.i64:
-    n = ti.i64(0)
-    for _ in ti.grouped(K):
-        n += 1
-    return n
-
-
-@ti.kernel
-def clear_rows(K: ti.template()):
-    """Zero the allocated blocks of a sparse row field (solver/fields.py ``row_field``): a
-    struct-for visits only those, where the dense rows are cleared node by node over the box."""
-    for idx in ti.grouped(K):
-        K[idx] = 0.0
 
 
 @ti.func

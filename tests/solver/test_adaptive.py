@@ -87,7 +87,7 @@ def test_step_changes_measure_temperature_and_strain():
     assert de == pytest.approx(np.linalg.norm(e), rel=1e-10)
     assert dx == 0.0
     assert dp == pytest.approx(0.004, rel=1e-10)
-    assert ex == 0.0  # no velocity changed
+    assert ex == pytest.approx(0.5 * 0.004, rel=1e-10)  # from rest: half the increment
     c = sim.adaptive.controls
     assert sim.adaptive.changes_ratio(1e-6) == pytest.approx(
         max(2.5 / c.temperature_K, de / c.strain)
@@ -98,36 +98,36 @@ def test_step_changes_measure_temperature_and_strain():
     )
 
 
-def test_position_error_is_backward_eulers_local_error():
-    """strain_control = "error": the step's local position error dt |v - v_before| / 2 (the
-    exact local error of backward Euler for a constant acceleration a: dt^2 a / 2, with
-    v - v_before = a dt) of the points that flow (their plastic strain grew; an elastic
-    point's jump is quasi-static, whatever the step), read as the square root of its ratio to
-    max_position_error_cells h (the error grows as dt^2, the other controls as dt), in place
-    of the strain increment."""
+def test_strain_error_is_backward_eulers_local_error():
+    """strain_control = "error": the step's local error of the plastic strain, dt |r - r_last|
+    / 2 with r = dp / dt the point's plastic rate over the step and r_last over the last one
+    (the exact local error of backward Euler for a rate changing at a constant pace c: dt^2 c
+    / 2), read as the square root of its ratio to max_strain_error (the error grows as dt^2,
+    the other controls as dt) in place of the increment; an accepted step's rates become the
+    next one's last."""
     case = load_case("power25W_coarse", [*ADAPTIVE, "time.strain_control=error"])
     sim = Simulation(case)
-    assert sim.adaptive.controls.position_error == case.time.max_position_error_cells
-    n, dt, a = sim.state.n_points, 1e-6, 3.0e2
-    v0 = np.zeros((n, 2))
-    sim.state.points.v.from_numpy(v0)
-    plastic = np.zeros(n)
+    ad = sim.adaptive
+    assert ad.controls.strain_error == case.time.max_strain_error
+    n, dt = sim.state.n_points, 1e-6
+    last = np.zeros((n, 2))
+    last[:, 0] = 50.0  # every point flowed at 50 / s over the last step
+    ad.rates.from_numpy(last)
+    plastic = np.full(n, 0.1)
     sim.state.points.equivalent_plastic_strain.from_numpy(plastic)
-    sim.adaptive.save()
-    v1 = v0.copy()
-    v1[13] = [0.0, a * dt]  # one flowing point accelerates at a over the step
-    v1[21] = [0.0, -0.5 * a * dt]  # an elastic one jumps, less: it would not set the error
-    v1[29] = [0.0, 9.0 * a * dt]  # ... nor would it more
-    plastic[13] = 1e-9
+    sim.state.points.v.fill(0.0)
+    ad.save()
+    plastic += 50.0 * dt  # the same rate again: no error ...
+    plastic[13] += 2e-3 * dt  # ... but at point 13, whose rate rose by 2e-3 / s
     sim.state.points.equivalent_plastic_strain.from_numpy(plastic)
-    sim.state.points.v.from_numpy(v1)
-    ratio = sim.adaptive.changes_ratio(dt)
-    ex = sim.adaptive.changes[None][4]
-    assert ex == pytest.approx(0.5 * a * dt**2, rel=1e-12)
-    h = sim.state.cfg.h
-    want = np.sqrt(ex / (case.time.max_position_error_cells * h))
-    motion = 9.0 * a * dt**2 / (sim.adaptive.controls.cells * h)  # the fastest point's v dt
-    assert ratio == pytest.approx(max(want, motion), rel=1e-12)
+    ratio = ad.changes_ratio(dt)
+    ep = ad.changes[None][4]
+    assert ep == pytest.approx(0.5 * 2e-3 * dt, rel=1e-6)
+    assert ratio == pytest.approx(np.sqrt(ep / case.time.max_strain_error), rel=1e-6)
+    ad.points_pass(PointsPass.ACCEPT)
+    rates = ad.rates.to_numpy()
+    assert rates[13, 0] == pytest.approx(50.0 + 2e-3, rel=1e-9)
+    assert rates[0, 0] == pytest.approx(50.0, rel=1e-9)
 
 
 def test_laser_switch_times():

@@ -103,7 +103,7 @@ def test_sparse_rows_follow_the_material_and_change_nothing():
     against "dense": a sphere falling in a box twice its size under implicit steps moves bit
     for bit the same (the same sums into zeroed rows), and the blocks hold storage for fewer
     than half the grid's nodes (those within reach of the sphere's)."""
-    from taichi_sls.solver.implicit import allocated_row_nodes
+    from taichi_sls.solver.fields import allocated_row_nodes
 
     def run(rows: str) -> tuple[np.ndarray, int, int]:
         body = {"center_um": [16.0, 16.0, 16.0], "radius_um": 6.0, "temperature_C": 20.0}

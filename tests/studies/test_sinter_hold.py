@@ -28,7 +28,8 @@ def test_hopper_at_a_constant_temperature_is_hoppers_clock():
 
 # the plastic control runs on request: the default suite keeps the bundled case's own control
 @pytest.mark.parametrize(
-    "strain_control", ["total", pytest.param("plastic", marks=pytest.mark.slow)]
+    "strain_control",
+    ["total", *(pytest.param(c, marks=pytest.mark.slow) for c in ("plastic", "error"))],
 )
 def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path, strain_control):
     """The bundled case for its second (the implicit integrator, adaptive steps, backward-Euler
@@ -39,7 +40,9 @@ def test_a_laser_melted_pair_sinters_as_hopper_says_at_its_temperature(tmp_path,
     runs at the pair's mean temperature, and while the pair cools its neck is hotter than the mean);
     molten and at 170 C throughout the hold; the neck has grown by 2.5 times. The same with the
     step controlled by the plastic (viscous) strain increment instead of the total one (measured
-    -0.6 % at 1 s, at most +3.1 %, in 211 steps against 542)."""
+    -0.6 % at 1 s, at most +3.1 %, in 211 steps against 542), and by that strain's local error
+    (strain_control = "error", max_strain_error 2e-3: -0.7 % at 1 s, at most +2.8 %, in 186
+    steps)."""
     sets = ["output.png=false", "output.gif=false", f"time.strain_control={strain_control}"]
     case = load_case("sinter_hold", sets)
     summary = run_case(case, tmp_path, progress=False)
