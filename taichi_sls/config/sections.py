@@ -173,7 +173,7 @@ class Contact(Model):
         "the interface, on the colour neck_colour names (sub-cell, any direction; a gap "
         "crossing the section is ignored; docs/record/verification.md)",
     )
-    neck_colour: Literal["filtered", "raw"] = Field(
+    neck_colour: Literal["filtered", "raw", "kernel"] = Field(
         "filtered",
         description="the colour the sections across the centres read (the centres section's "
         "contact line and verdict, a bed's necks and fused fraction). filtered: after the "
@@ -181,7 +181,11 @@ class Contact(Model):
         "it closes the one-cell notch the points of two bodies leave along a node-line "
         "mid-plane: Hopper within 3 % at tau = 0.5-3, R0/h = 20); raw: the cell fraction "
         "itself (the seeded outline; a concave neck of curvature kappa reads about kappa h^2 "
-        "narrower than filtered, the notch read as it is; docs/record/verification.md)",
+        "narrower than filtered, the notch read as it is; docs/record/verification.md); "
+        "kernel: the points' own kernel sum, each point's current volume spread with its "
+        "uGIMP shape function, on a raster of h / 4 around each contact (no interpolation "
+        "between nodes: its outline does not depend on h at leading order; "
+        "solver/kernel_colour.py)",
     )
     settle: bool = Field(
         False,
