@@ -86,7 +86,9 @@ def test_a_neck_below_the_initial_diameter_reads_as_before(name, sets):
     as cases/power25W_resolved.toml sets it) now reaches pair_reach, not the smaller radius:
     a neck inside the old reach reads what it read, to round-off (the sections are sampled at
     whole steps from the line of centres, so the longer reach adds samples, moving none). The
-    paper's cases read the column and do not call necks_m."""
+    paper's cases read the column and do not call necks_m. On a node field: the filtered
+    colour (the kernel colour's raster is its own, solver/kernel_colour.py)."""
+    sets = ("contact.neck_colour=filtered", *sets)
     sim = Simulation(load_case(name, ["solver.optimize=false", *sets]))
     field = sim.necks.material_field(sim.necks.neck_measure(), "centres")
     centre, (ra, rb), cfg = sim.necks.body_centres_m(), sim.necks.body_radii_m[:2], sim.state.cfg
