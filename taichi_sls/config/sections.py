@@ -175,19 +175,13 @@ class Contact(Model):
     )
     neck_colour: Literal["kernel", "filtered", "raw"] = Field(
         "kernel",
-        description="the colour the sections across the centres read (the centres section's "
-        "contact line and verdict, a bed's necks and fused fraction). kernel: the points' own "
-        "kernel sum, each point's current volume spread with its uGIMP shape function, on a "
-        "raster of h / 4 (3D: h / 2) around each contact, closed by a disc of one cell (it "
-        "fills the slot about a cell wide that two coalescing bodies' points leave along their "
-        "mid-plane and keeps every outline whose concave radius exceeds a cell: it converges "
-        "in h, +0.3 % between h = 2 and 1 um on the resolved pair, Hopper within 2.6 % at "
-        "tau = 0.5-3, R0/h = 20; solver/kernel_colour.py). filtered: after the force's "
-        "[1 2 1] / 4 pass along x and y (the outline the surface-energy force moves; it widens "
-        "a concave neck of curvature kappa by about kappa h^2 / 4: +3.2 % between h = 2 and "
-        "1 um on the resolved pair; the reading before issue #54); raw: the cell fraction on "
-        "the nodes, bilinear between them (the one-cell notch along a coalescing pair's "
-        "mid-plane read as it is: -13.4 % from Hopper at tau = 0.5; docs/record/verification.md)",
+        description="the colour the sections across the centres read (their contact line and "
+        "verdict, a bed's necks). kernel: the points' kernel sum (each point's volume spread "
+        "with its uGIMP shape function) on a raster of h / 4 (3D: h / 2), closed by a disc of "
+        "one cell (it fills the slot two coalescing bodies' points leave on their mid-plane; "
+        "solver/kernel_colour.py). filtered: after the force's [1 2 1] / 4 pass (the default "
+        "before issue #54: it widens a concave neck by about kappa h^2 / 4). raw: the cell "
+        "fraction on the nodes (it reads the slot; docs/record/verification.md)",
     )
     settle: bool = Field(
         False,

@@ -100,8 +100,9 @@ def test_a_neck_below_the_initial_diameter_reads_as_before(name, sets):
 
 @pytest.mark.parametrize("colour", ["filtered", "raw"])
 def test_the_sections_read_the_colour_the_case_names(colour):
-    """contact.neck_colour: "filtered" (the default before issue #54) reads the force's own filtered colour (the
-    numpy filter equals the kernel's to round-off), "raw" the cell fraction itself; the bed's
+    """contact.neck_colour: "filtered" (the default before issue #54) reads the force's own
+    filtered colour (the numpy filter equals the kernel's to round-off), "raw" the cell
+    fraction itself; the bed's
     pair_necks_m reads the same as necks_m for two bodies on either. The paper's touching pair
     at t = 0: 13.58 um filtered, 9.33 um raw (test_surface_energy's column values)."""
     sim = Simulation(
