@@ -44,7 +44,10 @@ from .neck_section import FAR_APART, SECTION_RANGE, neck_section
 # contact at h / 4 (0.12 s at h / 2); pair3d_25W's seeded 4 um fillet (exact 18.53 um) reads
 # 18.87 um at h / 2, 19.04 um at h / 4
 REFINE = {2: 4, 3: 2}
-CLOSING_CELLS = 1.0  # radius of the closing disc (ball), in cells
+# radius of the closing disc (ball), in cells: at 1/2 and 3/4 cell the slot still reads -7.5 /
+# -4.3 % on Hopper's pair at tau = 0.5 (-2.6 % at 1); beyond one cell the disc fills resolved
+# geometry (the settled pair at h = 2 um moves; docs/record/verification.md)
+CLOSING_CELLS = 1.0
 CHUNK = 4096  # points spread at a time (each to 11^2 raster nodes in 2D, 7^3 in 3D)
 
 
