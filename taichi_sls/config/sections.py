@@ -173,15 +173,15 @@ class Contact(Model):
         "the interface, on the colour neck_colour names (sub-cell, any direction; a gap "
         "crossing the section is ignored; docs/record/verification.md)",
     )
-    neck_colour: Literal["filtered", "raw"] = Field(
-        "filtered",
-        description="the colour the sections across the centres read (the centres section's "
-        "contact line and verdict, a bed's necks and fused fraction). filtered: after the "
-        "force's [1 2 1] / 4 pass along x and y (the outline the surface-energy force moves; "
-        "it closes the one-cell notch the points of two bodies leave along a node-line "
-        "mid-plane: Hopper within 3 % at tau = 0.5-3, R0/h = 20); raw: the cell fraction "
-        "itself (the seeded outline; a concave neck of curvature kappa reads about kappa h^2 "
-        "narrower than filtered, the notch read as it is; docs/record/verification.md)",
+    neck_colour: Literal["kernel", "filtered", "raw"] = Field(
+        "kernel",
+        description="the colour the sections across the centres read (their contact line and "
+        "verdict, a bed's necks). kernel: the points' kernel sum (each point's volume spread "
+        "with its uGIMP shape function) on a raster of h / 4 (3D: h / 2), closed by a disc of "
+        "one cell (it fills the slot two coalescing bodies' points leave on their mid-plane; "
+        "solver/kernel_colour.py). filtered: after the force's [1 2 1] / 4 pass (the default "
+        "before issue #54: it widens a concave neck by about kappa h^2 / 4). raw: the cell "
+        "fraction on the nodes (it reads the slot; docs/record/verification.md)",
     )
     settle: bool = Field(
         False,

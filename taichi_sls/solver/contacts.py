@@ -94,7 +94,7 @@ def touching(points: np.ndarray, body: np.ndarray, spacing: float) -> list[tuple
     return sorted({(int(a), int(b)) for a, b in zip(lo, hi, strict=True)})
 
 
-def _gimp_1d(xi: np.ndarray, h: float, lp: float) -> np.ndarray:
+def gimp_1d(xi: np.ndarray, h: float, lp: float) -> np.ndarray:
     """The uGIMP weight of physics/shape.py (gimp_1d), in numpy."""
     a = np.abs(xi)
     r = h + lp - a
@@ -115,7 +115,7 @@ def point_colour(
     out = np.zeros(shape)
     f = x / h
     base = np.floor(f + 0.5).astype(int) - 1
-    w = [_gimp_1d((f - (base + a)) * h, h, lp) for a in range(3)]  # each (N, 2)
+    w = [gimp_1d((f - (base + a)) * h, h, lp) for a in range(3)]  # each (N, 2)
     idx = np.clip(base + off, 1, np.array(shape) - 4)
     for a in range(3):
         for b in range(3):

@@ -36,20 +36,29 @@ PLANE_STEP = 0.25  # lattice spacing in each 3D section plane, in cells
 
 
 def neck_section(
-    material: np.ndarray, h: float, off: int, ca: np.ndarray, cb: np.ndarray, reach: float
+    material: np.ndarray,
+    h: float,
+    off: int,
+    ca: np.ndarray,
+    cb: np.ndarray,
+    reach: float,
+    cell: float | None = None,
 ) -> tuple[float, np.ndarray]:
     """The neck of one contact (m) and where it lies, on a node field that is >= 0 in the
     material (c - 1/2 of the colour, or -phi of eq. 21): the narrowest section normal to
     ca -> cb (the widest once convex), its width in 2D, 2 sqrt(A / pi) in 3D, sampled out to
-    ``reach`` from the line of centres."""
+    ``reach`` from the line of centres. ``cell``: the length the sampling steps are counted in
+    (default h; the grid's cell where the field lies on a finer raster of spacing h, so that
+    the raster refines the field, not the number of samples)."""
+    cell = h if cell is None else cell
     d = float(np.linalg.norm(cb - ca))
     # a blown-up state (the guard reports it): centres NaN, or flung far beyond the bodies' size
     if not (math.isfinite(d) and math.isfinite(reach) and 0.0 < d <= FAR_APART * reach):
         return math.nan, np.full(len(ca), math.nan)
     e = (cb - ca) / d
-    step = SECTION_STEP * h
+    step = SECTION_STEP * cell
     s = np.arange((0.5 - SECTION_RANGE) * d, (0.5 + SECTION_RANGE) * d + 0.5 * step, step)
-    sizes = SECTIONS[len(ca)](material, h, off, ca, e, s, reach)
+    sizes = SECTIONS[len(ca)](material, h, off, ca, e, s, reach, cell)
     k = int(np.argmin(sizes))
     # a pair coalesced past its waist is convex: its sections narrow away from the middle, and
     # the narrowest is the range's end, not the neck; read it where it is widest (Hopper's r_n
@@ -63,11 +72,19 @@ def neck_section(
 
 
 def line_widths(
-    material: np.ndarray, h: float, off: int, ca: np.ndarray, e: np.ndarray, s, reach: float
+    material: np.ndarray,
+    h: float,
+    off: int,
+    ca: np.ndarray,
+    e: np.ndarray,
+    s,
+    reach: float,
+    cell: float,
 ) -> np.ndarray:
-    """2D: the width of each section line at ca + s e across e (m)."""
+    """2D: the width of each section line at ca + s e across e (m), sampled every
+    SECTION_STEP ``cell``."""
     n = np.array([-e[1], e[0]])
-    step = SECTION_STEP * h
+    step = SECTION_STEP * cell
     # whole steps either side of the line of centres: the same samples whatever the reach, so a
     # longer reach reads a section inside the shorter one's span as that one did
     n_t = math.ceil(reach / step - 1e-9)
@@ -78,11 +95,19 @@ def line_widths(
 
 
 def plane_areas(
-    material: np.ndarray, h: float, off: int, ca: np.ndarray, e: np.ndarray, s, reach: float
+    material: np.ndarray,
+    h: float,
+    off: int,
+    ca: np.ndarray,
+    e: np.ndarray,
+    s,
+    reach: float,
+    cell: float,
 ) -> np.ndarray:
-    """3D: the area of each section plane through ca + s e normal to e (m^2)."""
+    """3D: the area of each section plane through ca + s e normal to e (m^2), on a lattice of
+    PLANE_STEP ``cell``."""
     u, w = plane_basis(e)
-    lat = PLANE_STEP * h
+    lat = PLANE_STEP * cell
     n_t = math.ceil(reach / lat - 1e-9)
     t = lat * np.arange(-n_t, n_t + 1)
     plane = t[:, None, None] * u + t[None, :, None] * w  # (T, T, 3)

@@ -10,6 +10,7 @@ from . import struct_copy
 from .contacts import point_colour
 from .fields import State
 from .grid_views import interface_fields
+from .kernel_colour import kernel_neck
 from .monitor import neck_measures
 from .neck_section import equivalent_radii, filtered_colour, neck_section, pair_reach
 
@@ -111,7 +112,9 @@ class Necks:
     def section_colour(self, raw: np.ndarray) -> np.ndarray:
         """The colour a section across the centres reads, from a raw colour: the force's filter
         of it (``contact.neck_colour = "filtered"``, closing the notch along a node-line
-        mid-plane) or itself (``"raw"``: the seeded outline, a concave neck unwidened)."""
+        mid-plane) or itself (``"raw"``: the seeded outline, a concave neck unwidened;
+        ``"kernel"``, whose sections read a raster of the points instead (:meth:`necks_m`):
+        its samples at the nodes)."""
         if self.case.contact.neck_colour != "filtered":
             return raw
         return filtered_colour(raw)
@@ -122,8 +125,33 @@ class Necks:
         interface (:func:`taichi_sls.solver.neck_section.neck_section`), out to the pair's reach."""
         if not self.contacts:
             return []
-        field = self.material_field(measure or self.neck_measure(), "centres")
+        measure = measure or self.neck_measure()
+        if self.reads_kernel(measure):
+            everyone = np.arange(len(self.mass))
+            return self._kernel_necks(lambda a, b: everyone)
+        field = self.material_field(measure, "centres")
         return self._contact_necks(lambda a, b: field)
+
+    def reads_kernel(self, measure: str) -> bool:
+        """Whether the sections across the centres read the points' own kernel colour
+        (``contact.neck_colour = "kernel"``, on the colour measure): a raster per contact,
+        no node field (solver/kernel_colour.py)."""
+        return measure == "colour" and self.case.contact.neck_colour == "kernel"
+
+    def _kernel_necks(self, members_of) -> list[float]:
+        """The neck of every contact on the kernel colour of the points ``members_of(a, b)``
+        (indices), rastered over the box the contact's sections span."""
+        centre, r, cfg = self.body_centres_m(), self.body_radii_m, self.state.cfg
+        pts = point_arrays(self.state, ("x", "volume0", "J"))
+        x, volume = pts["x"], pts["volume0"] * pts["J"]
+        necks = []
+        for a, b in self.contacts:
+            sel = members_of(a, b)
+            reach = pair_reach(r[a], r[b], cfg.dim)
+            necks.append(
+                kernel_neck(x[sel], volume[sel], cfg.h, cfg.lp, centre[a], centre[b], reach)
+            )
+        return necks
 
     def _contact_necks(self, field_of) -> list[float]:
         """neck_section of every contact on ``field_of(a, b)``, sampled out to
@@ -173,11 +201,13 @@ class Necks:
         if not self.contacts:
             return []
         cfg = self.state.cfg
-        x, weight = point_arrays(self.state, ("x",))["x"], self.colour_weights()
         body = self.state.scene.body
         order = np.argsort(body, kind="stable")
         bounds = np.searchsorted(body[order], np.arange(len(self.body_radii_m) + 1))
         members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self.body_radii_m))]
+        if self.reads_kernel("colour"):
+            return self._kernel_necks(lambda a, b: np.concatenate([members[a], members[b]]))
+        x, weight = point_arrays(self.state, ("x",))["x"], self.colour_weights()
         shape = (cfg.nx, cfg.ny) if cfg.dim == 2 else (cfg.nx, cfg.ny, cfg.nz)
 
         def colour(a: int, b: int) -> np.ndarray:

@@ -36,13 +36,14 @@ def test_pair3d_25W_settles_by_implicit_steps_and_melts_the_contact(tmp_path):
     """A short run of the bundled case (about 1 min on 2 cores): the pair settles unheated
     within 0.2 ms (implicit steps, handing back to explicit ones where the controls ask;
     before symmetric_eigen no implicit step converged here and the explicit steps never got
-    there in 9 min), its neck zipped open from the seeded 20.2 um (measured 21.02 um), and the
-    pulse's first 20 us melts the contact region."""
+    there in 9 min), its neck zipped open from the seeded 18.87 um (the default kernel colour;
+    measured 19.72 um settled; 20.19 -> 21.02 um on the filtered colour), and the pulse's
+    first 20 us melts the contact region."""
     from taichi_sls.jobs.case_run import run_case
 
     case = load_case("pair3d_25W", ["time.stop=end", "time.end_s=2e-5"])
     s = run_case(case, tmp_path, progress=False)
     assert s["status"] == "complete"
     assert s["settle"]["time_s"] < 2e-4
-    assert s["settle"]["neck_um"] > 20.5
+    assert s["settle"]["neck_um"] > 19.3
     assert s["final"]["molten_fraction"] > 0.9

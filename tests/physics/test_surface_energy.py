@@ -140,8 +140,8 @@ def test_colour_contact_line_of_the_paper_pair():
     wide; both fall as sqrt(h): touching circles meet in a point, docs/record/verification.md); the
     level set of eq. 21 gives the paper's 8.27 um beside it. All on the vertical node column
     (contact.neck_section = "column"). The section across the centres reads the colour that
-    contact.neck_colour names whatever the force's filter: filtered (the default), the
-    filtered column's value; raw, the unfiltered one."""
+    contact.neck_colour names whatever the force's filter: filtered (the default before issue
+    #54), the filtered column's value; raw, the unfiltered one."""
     cls, across, across_raw = [], [], []
     for filt in ("true", "false"):
         sim = Simulation(
@@ -156,6 +156,7 @@ def test_colour_contact_line_of_the_paper_pair():
         m = sim.monitors()
         cls.append(m["contact_line_um"])
         assert m["contact_line_level_set_um"] == pytest.approx(8.27, abs=0.01)
+        sim.case.contact.neck_colour = "filtered"
         across.append(sim.necks.necks_m("colour")[0] * 1e6)
         sim.case.contact.neck_colour = "raw"
         across_raw.append(sim.necks.necks_m("colour")[0] * 1e6)
@@ -226,12 +227,13 @@ def test_hopper_from_touching_discs_R0_h_20():
     shared cores).
 
     The same run read by the per-contact section the process results rest on
-    (``Necks.necks_m``: reach ``pair_reach``, the filtered colour of
-    ``contact.neck_colour``; issue #40 item 6): within 3 % (that item's bar) at all four times,
-    past the discs' initial diameter from tau ~1.45 on (measured -2.87 / -2.11 / -0.38 /
-    -0.10 %; 25 min on two crowded cores; the raw colour read -13.5 / -4.7 / -0.36 / +0.40 %:
-    it keeps the one-cell notch along the node-line mid-plane that the filter closes;
-    docs/record/verification.md)."""
+    (``Necks.necks_m``: reach ``pair_reach``, the default colour of ``contact.neck_colour``,
+    the points' kernel sum closed by a one-cell disc; issues #40 item 6 and #54 item 5):
+    within 3 % (those items' bar) at all four times, past the discs' initial diameter from
+    tau ~1.45 on (measured -2.58 / -1.70 / -0.65 / +1.20 %; 10 min on one shared core; the
+    force's filtered colour, the default before, read -2.87 / -2.11 / -0.38 / -0.10 %, the raw
+    colour -13.4 / -4.6 / -0.26 / +0.49 %: it keeps the slot the two bodies' points leave along
+    the node-line mid-plane, which the closing fills; docs/record/verification.md)."""
     r = ver.run(ver.load("hopper", 20))
     print(r.errors)
     for k in ("neck_tau0.5", "neck_tau1", "neck_tau2", "neck_tau3"):
