@@ -19,7 +19,7 @@ Arguments: ``cfg`` the step's configuration, ``nd`` the nodes (``v``, ``mass``,
 from taichi_sls.backend import ti
 
 from .grid import active, scatter_add
-from .small_matrix import ZERO_VECTOR
+from .small_matrix import IDENTITY, ZERO_VECTOR
 from .surface_energy import in_passes, spread_light_node
 
 CELL_CORNERS = {dim: (2,) * dim for dim in (2, 3)}  # a cell's corner offsets, by dimension
@@ -54,12 +54,24 @@ def cell_divergence(cfg: ti.template(), nd: ti.template(), xp):
 
 
 @ti.func
-def scatter_pressure_force(cfg: ti.template(), nd: ti.template(), xp, V, mean_stress):
-    """-V mean_stress grad N at the centre of x_p's cell, onto its corners (nd.pressure_force,
-    before the floor)."""
+def cell_velocity_gradient(cfg: ti.template(), nd: ti.template(), xp, L):
+    """L with its trace replaced by the divergence at the centre of x_p's cell: the cell's
+    dilatation, the point's own shear (the explicit motion and the implicit residual alike)."""
+    div = cell_divergence(cfg, nd, xp)
+    return L + (div - L.trace()) / cfg.dim * ti.Matrix(IDENTITY[cfg.dim])
+
+
+@ti.func
+def cell_pressure_force(cfg: ti.template(), target: ti.template(), xp, V, sig):
+    """-V mean_stress grad N at the centre of x_p's cell onto its corners in ``target`` (the
+    explicit step's nd.pressure_force, before the floor; the implicit step's internal force);
+    returns the deviator, whose force goes through the point's own gradients. The mean is the
+    in-plane one in 2D (trace / dim), as the cell's divergence is."""
+    mean_stress = sig.trace() / cfg.dim
     c = point_cell(cfg, xp)
     for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
-        scatter_add(cfg, nd.pressure_force, c + o, -V * mean_stress * corner_gradient(cfg, o))
+        scatter_add(cfg, target, c + o, -V * mean_stress * corner_gradient(cfg, o))
+    return sig - mean_stress * ti.Matrix(IDENTITY[cfg.dim])
 
 
 @ti.func
