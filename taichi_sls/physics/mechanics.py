@@ -65,7 +65,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         if ti.static(cfg.solvent):
             sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
         if ti.static(cfg.cell_dilatation):  # the mean stress through the cell's gradient
-            sig = cell_pressure_force(cfg, nd.pressure_force, xp, Vp, sig)
+            sig = cell_pressure_force(cfg, nd, nd.pressure_force, xp, Vp, sig)
     g = ti.Vector(cfg.gravity, dt=float)
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)

@@ -175,7 +175,7 @@ def _point_force(st: ti.template(), p):
     sig, mu_t, K, eta = trial_stress(st.cfg, pt, st.materials, p, L, dt)
     V = pt.volume0[p] * pt.J[p]
     if ti.static(st.cfg.cell_dilatation):  # the mean stress through the cell's gradient
-        sig = cell_pressure_force(st.cfg, st.implicit.internal, pt.x[p], V, sig)
+        sig = cell_pressure_force(st.cfg, st.nodes, st.implicit.internal, pt.x[p], V, sig)
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[st.cfg.dim])):
         N, gN = node_weight(w, dw, o)
         st.implicit.internal[base + o] += -V * (sig @ gN)
@@ -189,7 +189,7 @@ def _force_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.templat
     base, w, dw, V, a_lam, a_mu = _point_force(st, p)
     if st.implicit.with_tangent[None]:
         xp = st.points.x[p]
-        scatter_tangent(st.cfg, st.implicit.tangent, base, w, dw, xp, V, a_lam, a_mu)
+        scatter_tangent(st.cfg, st.implicit.tangent, st.nodes, base, w, dw, xp, V, a_lam, a_mu)
 
 
 @ti.kernel

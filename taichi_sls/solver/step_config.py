@@ -172,22 +172,6 @@ def flip_share(case: Case, dt: float) -> float:
     return sv.flip_ratio ** (dt / sv.flip_ratio_dt_s)
 
 
-def mass_cut_fraction(case: Case) -> float:
-    """Nodes below this fraction of a full cell's mass rest: the explicit step's
-    ``solver.small_mass``; the implicit step's ``time.implicit_small_mass``, with
-    ``solver.dilatation = "cell"`` at least ``solver.dilatation_mass_floor``. There the cell's
-    gradient gives a corner that a point barely touches a full cell's volumetric stiffness, and
-    at steps where inertia no longer holds it the light corner takes up the cell's volume change
-    (hopper_pa12 at 10 ms steps: the neck tore and Newton failed with the 1e-3 cut, within 3 % of
-    Hopper with 1e-2; docs/record/verification.md). Resting it keeps the tangent symmetric, where
-    the explicit step's floor, spreading its force, would not."""
-    if not case.implicit_mechanics():
-        return case.solver.small_mass
-    if case.solver.dilatation == "cell":
-        return max(case.time.implicit_small_mass, case.solver.dilatation_mass_floor)
-    return case.time.implicit_small_mass
-
-
 DENSE_ROWS_MAX_BYTES = 2**30  # time.implicit_rows = "auto": blocks above this
 
 
@@ -318,7 +302,10 @@ def step_config(
         gamma_ramp_s=st.ramp_s,
         mass_scale=sv.mass_scale,
         rho_ref=rho_ref,
-        mass_cut=mass_cut_fraction(case) * first.density_kg_m3 * sv.mass_scale * h**dim,
+        mass_cut=(case.time.implicit_small_mass if implicit else sv.small_mass)
+        * first.density_kg_m3
+        * sv.mass_scale
+        * h**dim,
         gamma=first.surface_tension_N_m,
         r_p=st.point_radius_over_h * h,
         band=st.band_cells,
