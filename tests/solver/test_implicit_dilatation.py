@@ -38,16 +38,16 @@ def test_cell_tangent_is_the_derivative_of_the_internal_force():
 
 def _free_disc(spin: float) -> tuple[Simulation, np.ndarray]:
     """A PA12 disc in free flight (no surface tension, gravity or walls) under implicit steps
-    with the cells' dilatation, spun at ``spin`` rad/s about its centre; no light-node cut
-    (``time.implicit_small_mass`` and ``solver.dilatation_mass_floor``, which raises it with
-    "cell", both 0: a resting node would drop its momentum)."""
+    with the cells' dilatation (its light corners floored, solver.dilatation_mass_floor), spun
+    at ``spin`` rad/s about its centre; no light-node cut (``time.implicit_small_mass = 0``: a
+    resting node would drop its momentum)."""
     case = make_case(
         {
             "domain": {"width_um": 80.0, "height_um": 80.0},
             "bodies": [{"center_um": [30.0, 50.0], "radius_um": 8.0, "velocity_m_s": [0.3, -0.2]}],
             "physics": {"thermal": False, "surface_tension": False, "gravity_m_s2": [0.0, 0.0]},
             "boundary": {w: {"mechanical": "open"} for w in ("left", "right", "bottom", "top")},
-            "solver": {"transfer": "apic", "dilatation_mass_floor": 0.0, **CELL},
+            "solver": {"transfer": "apic", **CELL},
             "time": {"end_s": 1e-4, "integrator": "implicit", "implicit_small_mass": 0.0},
         }
     )
@@ -61,10 +61,9 @@ def _free_disc(spin: float) -> tuple[Simulation, np.ndarray]:
 
 
 def test_free_body_under_implicit_cell_steps_keeps_momentum_and_rigid_motion():
-    """Spinning: the cells' forces sum to zero on every corner set and the light corners,
-    neither floored nor rested, hold at these short steps (no NaN where the explicit step's
-    consistent Q1P0 went to NaN without its floor): momentum to round-off (measured 2e-15 of
-    sum m |v| over 30 steps of 2.5 us; bar 1e-13). Translating only: no spurious motion, every
+    """Spinning: the floored corner gradients of every cell still sum to zero, so the cells'
+    forces do: momentum to round-off (measured 3e-15 of sum m |v| over 30 steps of 2.5 us; bar
+    1e-13). Translating only: no spurious motion, every
     point keeps the body's velocity and its volume (measured 2e-14 m/s against 0.36 m/s,
     |J - 1| 2e-13; bars 1e-12)."""
     sim, v = _free_disc(2e4)
