@@ -22,6 +22,11 @@ R = 20 um at R/h = 5 joined by a 4 um torus fillet, their line of centres along 
 and (1, 1, 1), each point's own dilatation and the cells', explicit and implicit steps; the neck
 over the diameter every 15 us to 45 us; isotropy3d.csv and isotropy3d.json (per run the worst
 ratio to the pair along x at the same times).
+
+``--golden``: instead, the golden runs of tests/jobs/test_golden_runs.py (their short settings)
+with ``solver.dilatation`` "point" (the default) and "cell": the last row of each time series
+(neck, median neck, density, contacts fused, J_min, peak temperature) in isotropy_golden.json
+(docs/record/verification.md, "The answers that would move").
 """
 
 from __future__ import annotations
@@ -58,6 +63,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap.add_argument("--out", default="renders", help="folder for the CSV, JSON and plot")
     ap.add_argument("--beds", nargs="+", metavar="RUN", help="bed runs' folders: their contacts")
     ap.add_argument("--spheres", action="store_true", help="the 3D pair along x, xy, xyz")
+    ap.add_argument("--golden", action="store_true", help="the golden runs, point and cell")
     ap.set_defaults(func=main)
 
 
@@ -68,6 +74,8 @@ def main(args: argparse.Namespace) -> int:
         return beds(args.beds, out)
     if args.spheres:
         return spheres(out)
+    if args.golden:
+        return golden(out)
     grids = GRIDS[:2] if args.quick else GRIDS
     rows, runs = [], []
     for R0_over_h, fillet_um in grids:
@@ -249,4 +257,42 @@ def spheres(out: Path) -> int:
             )
     write_rows(out / "isotropy3d.csv", rows)
     atomic_write_text(out / "isotropy3d.json", json.dumps(runs, indent=1) + "\n")
+    return 0
+
+
+GOLDEN_KEYS = (
+    "contact_line_um",
+    "neck_median_um",
+    "relative_density",
+    "contacts_fused",
+    "contacts_melted_through",
+    "J_min",
+    "T_peak_C",
+)
+
+
+def golden(out: Path) -> int:
+    """The golden runs with each dilatation (module docstring)."""
+    import importlib.util
+    import tempfile
+
+    import taichi_sls as sls
+
+    path = Path(__file__).resolve().parents[1] / "tests" / "jobs" / "test_golden_runs.py"
+    spec = importlib.util.spec_from_file_location("golden_runs", path)
+    runs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(runs)
+    rows = []
+    for name, (case_name, overrides, _) in runs.RUNS.items():
+        for dilatation in ("point", "cell"):
+            sets = runs.COMMON + overrides + [f"solver.dilatation={dilatation}"]
+            with tempfile.TemporaryDirectory() as folder:
+                summary = sls.run_case(sls.load_case(case_name, sets), Path(folder), progress=False)
+                last = runs._table(Path(folder) / "timeseries.csv")[-1]
+            row = {"run": name, "case": case_name, "dilatation": dilatation}
+            row |= {k: float(last[k]) for k in GOLDEN_KEYS if k in last}
+            row["fused"] = summary.get("outcome", {}).get("fused")
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    atomic_write_text(out / "isotropy_golden.json", json.dumps(rows, indent=1) + "\n")
     return 0
