@@ -16,6 +16,17 @@ resolved.toml; e.g. ``python -m taichi_sls.run cases/bed_track.toml --set bed.se
 RUN``): each melted contact's neck growth (final over initial) against its line of centres'
 angle to the grid folded into [0, 45] deg, the least-squares slope per run with its standard
 error; isotropy_bed.csv, isotropy_bed.json and isotropy_bed.png.
+
+``--spheres``: instead, the 3D check (studies/verification/isotropy3d.py): two spheres of
+R = 20 um at R/h = 5 joined by a 4 um torus fillet, their line of centres along x, (1, 1, 0)
+and (1, 1, 1), each point's own dilatation and the cells', explicit and implicit steps; the neck
+over the diameter every 15 us to 45 us; isotropy3d.csv and isotropy3d.json (per run the worst
+ratio to the pair along x at the same times).
+
+``--golden``: instead, the golden runs of tests/jobs/test_golden_runs.py (their short settings)
+with ``solver.dilatation`` "point" (the default) and "cell": the last row of each time series
+(neck, median neck, density, contacts fused, J_min, peak temperature) in isotropy_golden.json
+(docs/record/verification.md, "The answers that would move").
 """
 
 from __future__ import annotations
@@ -51,6 +62,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ap.add_argument("--quick", action="store_true", help="R0/h = 5 and 10 only")
     ap.add_argument("--out", default="renders", help="folder for the CSV, JSON and plot")
     ap.add_argument("--beds", nargs="+", metavar="RUN", help="bed runs' folders: their contacts")
+    ap.add_argument("--spheres", action="store_true", help="the 3D pair along x, xy, xyz")
+    ap.add_argument("--golden", action="store_true", help="the golden runs, point and cell")
     ap.set_defaults(func=main)
 
 
@@ -59,6 +72,10 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     if args.beds:
         return beds(args.beds, out)
+    if args.spheres:
+        return spheres(out)
+    if args.golden:
+        return golden(out)
     grids = GRIDS[:2] if args.quick else GRIDS
     rows, runs = [], []
     for R0_over_h, fillet_um in grids:
@@ -180,4 +197,102 @@ def beds(runs: list[str], out: Path) -> int:
     plt.close(fig)
     write_rows(out / "isotropy_bed.csv", rows)
     atomic_write_text(out / "isotropy_bed.json", json.dumps(trends, indent=1) + "\n")
+    return 0
+
+
+SPHERE_TIMES = np.linspace(0.0, 45e-6, 4)
+SPHERE_RUNS = {  # name: the case keys it sets
+    f"{integrator} {dilatation}": {
+        "solver": {"dilatation": dilatation, "optimize": False},  # the quick compile
+        "time": {"integrator": integrator},
+    }
+    for integrator, dilatation in (
+        ("implicit", "point"),
+        ("implicit", "cell"),
+        ("explicit", "point"),
+        ("explicit", "cell"),
+    )
+}
+
+
+def spheres(out: Path) -> int:
+    """The 3D pair along x, xy and xyz (module docstring)."""
+    from taichi_sls.studies.verification.isotropy3d import (
+        DIRECTIONS,
+        sphere_neck_history,
+        sphere_pair,
+        worst_ratio,
+    )
+
+    rows, runs = [], []
+    for name, sets in SPHERE_RUNS.items():
+        hists = []
+        for direction in DIRECTIONS:
+            hist = sphere_neck_history(sphere_pair(direction, 20.0, 5.0, 4.0, sets), SPHERE_TIMES)
+            hists.append(hist)
+            worst = worst_ratio([hists[0], hist]) if len(hists) > 1 else 0.0
+            runs.append(
+                {
+                    "run": name,
+                    "direction": direction,
+                    "worst_ratio_to_along_x": worst,
+                    "wall_s": hist.wall_s,
+                    "steps": hist.steps,
+                }
+            )
+            rows += [
+                {
+                    "run": name,
+                    "direction": direction,
+                    "t_us": round(t * 1e6, 3),
+                    "neck": round(n, 6),
+                }
+                for t, n in zip(hist.times, hist.neck, strict=True)
+            ]
+            print(
+                f"{name:14s} {direction:4s} neck / 2R {' '.join(f'{n:.4f}' for n in hist.neck)}"
+                f"  worst ratio to x {worst * 100:5.2f} %  ({hist.steps} steps, "
+                f"{hist.wall_s:.0f} s)",
+                flush=True,
+            )
+    write_rows(out / "isotropy3d.csv", rows)
+    atomic_write_text(out / "isotropy3d.json", json.dumps(runs, indent=1) + "\n")
+    return 0
+
+
+GOLDEN_KEYS = (
+    "contact_line_um",
+    "neck_median_um",
+    "relative_density",
+    "contacts_fused",
+    "contacts_melted_through",
+    "J_min",
+    "T_peak_C",
+)
+
+
+def golden(out: Path) -> int:
+    """The golden runs with each dilatation (module docstring)."""
+    import importlib.util
+    import tempfile
+
+    import taichi_sls as sls
+
+    path = Path(__file__).resolve().parents[1] / "tests" / "jobs" / "test_golden_runs.py"
+    spec = importlib.util.spec_from_file_location("golden_runs", path)
+    runs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(runs)
+    rows = []
+    for name, (case_name, overrides, _) in runs.RUNS.items():
+        for dilatation in ("point", "cell"):
+            sets = runs.COMMON + overrides + [f"solver.dilatation={dilatation}"]
+            with tempfile.TemporaryDirectory() as folder:
+                summary = sls.run_case(sls.load_case(case_name, sets), Path(folder), progress=False)
+                last = runs._table(Path(folder) / "timeseries.csv")[-1]
+            row = {"run": name, "case": case_name, "dilatation": dilatation}
+            row |= {k: float(last[k]) for k in GOLDEN_KEYS if k in last}
+            row["fused"] = summary.get("outcome", {}).get("fused")
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    atomic_write_text(out / "isotropy_golden.json", json.dumps(rows, indent=1) + "\n")
     return 0

@@ -251,9 +251,10 @@ class Solver(Model):
         "paper's eq. 18; cell: the divergence at the centre of the point's grid cell of its "
         "corner nodes' velocities, shared by the cell's points, and the mean stress's force "
         "through the same gradient (the Q1P0 element's one volume per cell; the shear stays "
-        "the point's own), explicit USL steps only. With four points per cell each holding "
-        "its own volume a nearly incompressible flow locks, more along the grid than across "
-        "it: a filleted pair's neck grows up to 10 % faster across the diagonal "
+        "the point's own), USL steps, explicit or implicit (no mirror or periodic walls). With "
+        "four points per cell each holding its own volume a nearly incompressible flow locks, "
+        "more along the grid than across it: a filleted pair's neck grows up to 10 % faster "
+        "across the diagonal "
         "(docs/record/verification.md, neck growth at any angle)",
     )
     dilatation_mass_floor: float = Field(
@@ -263,7 +264,9 @@ class Solver(Model):
         description='dilatation = "cell": a node below this fraction of a full cell\'s mass '
         "keeps m_i / floor of the mean stress's force and hands the rest to its neighbours by "
         "mass (momentum kept), as the surface force's floor does: the cell's gradient reaches "
-        "corners that a point barely touches",
+        "corners that a point barely touches. The implicit step floors the gradient itself "
+        "(m_i / floor of it, the rest to the cell's corners by mass), so that its tangent "
+        "stays symmetric",
     )
     update: Literal["usl", "musl"] = Field(
         "usl",

@@ -280,16 +280,19 @@ class Case(Model):
                 "integrator linearises the surface-energy force only (allowed with it: "
                 '"surface_energy")'
             )
-        if self.solver.dilatation == "cell" and (
-            self.time.integrator != "explicit" or self.solver.update != "usl"
-        ):
+        if self.solver.dilatation == "cell" and self.solver.update != "usl":
             raise CaseError(
-                f'solver.dilatation = "cell" with time.integrator = {self.time.integrator!r} '
-                f"and solver.update = {self.solver.update!r}: the cells' dilatation is taken on "
-                "explicit USL steps only (the implicit step's tangent is assembled with each "
-                "point's own; MUSL remaps the velocity it is read from); allowed: "
-                'time.integrator = "explicit" with solver.update = "usl", or dilatation = '
-                '"point"'
+                f'solver.dilatation = "cell" with solver.update = {self.solver.update!r}: the '
+                "cells' dilatation is read from the grid velocity of the step, which MUSL "
+                'remaps; allowed with it: solver.update = "usl" (any time.integrator), or '
+                'dilatation = "point"'
+            )
+        if self.solver.dilatation == "cell" and self.time.linear_solver == "matrix_free":
+            raise CaseError(
+                'solver.dilatation = "cell" with time.linear_solver = "matrix_free": the '
+                "matrix-free tangent is each point's own (solver/multigrid.py), not the cell's "
+                'volumetric part; allowed with it: linear_solver = "auto", "direct" or "amg", or '
+                'dilatation = "point"'
             )
         folded = [
             w.mechanical

@@ -10,7 +10,12 @@ acts through the same gradient, so the internal power is sum_p V_p sigma_p : L_p
 points take. That gradient reaches corners that a point barely touches: a node below
 ``solver.dilatation_mass_floor`` of a full cell's mass keeps m_i / floor of this force and hands
 the rest to its neighbours by mass (momentum kept), as the surface force's floor does
-(physics/surface_energy.py).
+(physics/surface_energy.py). The implicit step floors the gradient instead, in both the
+divergence and the force, so that its tangent stays symmetric: corner k of a cell takes
+s_k g_k + (m_k / sum m) sum_j (1 - s_j) g_j, s_k = min(1, m_k / floor), which still sums to
+zero over the corners (momentum kept; a translation has no divergence). Unfloored, a light
+corner takes a full cell's volumetric stiffness and, at steps where inertia no longer holds it,
+the cell's volume change: hopper_pa12 at 10 ms steps tore its neck.
 
 Arguments: ``cfg`` the step's configuration, ``nd`` the nodes (``v``, ``mass``,
 ``pressure_force``, ``force``), ``box`` the active region.
@@ -19,7 +24,7 @@ Arguments: ``cfg`` the step's configuration, ``nd`` the nodes (``v``, ``mass``,
 from taichi_sls.backend import ti
 
 from .grid import active, scatter_add
-from .small_matrix import ZERO_VECTOR
+from .small_matrix import IDENTITY, ZERO_VECTOR
 from .surface_energy import in_passes, spread_light_node
 
 CELL_CORNERS = {dim: (2,) * dim for dim in (2, 3)}  # a cell's corner offsets, by dimension
@@ -44,22 +49,69 @@ def corner_gradient(cfg: ti.template(), o):
 
 
 @ti.func
+def light_corners(cfg: ti.template(), nd: ti.template(), c):
+    """The implicit step's floor of cell c (module docstring): the gradient its light corners
+    give up, sum_k (1 - s_k) g_k with s_k = min(1, m_k / floor), and the corners' mass."""
+    rest = ti.Vector(ZERO_VECTOR[cfg.dim])
+    mass = 0.0
+    if ti.static(_floored(cfg)):
+        for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
+            m = nd.mass[c + o]
+            rest += (1.0 - ti.min(1.0, m / cfg.dilatation_floor)) * corner_gradient(cfg, o)
+            mass += m
+    return rest, mass
+
+
+@ti.func
+def cell_gradient(cfg: ti.template(), nd: ti.template(), c, o, rest, mass):
+    """The gradient of corner o of cell c that the cell's divergence and mean stress take: at
+    the cell's centre; in the implicit step floored, s_o g_o plus its mass's share of what the
+    light corners give up (:func:`light_corners`)."""
+    g = corner_gradient(cfg, o)
+    if ti.static(_floored(cfg)):
+        m = nd.mass[c + o]
+        g = ti.min(1.0, m / cfg.dilatation_floor) * g + m / ti.max(mass, 1e-300) * rest
+    return g
+
+
+def _floored(cfg) -> bool:
+    """Whether the cell's gradient is floored: the implicit step's, with a floor."""
+    return cfg.implicit and cfg.dilatation_floor > 0.0
+
+
+@ti.func
 def cell_divergence(cfg: ti.template(), nd: ti.template(), xp):
     """div v at the centre of the cell that holds x_p, from its corner nodes."""
     c = point_cell(cfg, xp)
+    rest, mass = light_corners(cfg, nd, c)
     div = 0.0
     for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):  # at run time: one copy
-        div += nd.v[c + o].dot(corner_gradient(cfg, o))
+        div += nd.v[c + o].dot(cell_gradient(cfg, nd, c, o, rest, mass))
     return div
 
 
 @ti.func
-def scatter_pressure_force(cfg: ti.template(), nd: ti.template(), xp, V, mean_stress):
-    """-V mean_stress grad N at the centre of x_p's cell, onto its corners (nd.pressure_force,
-    before the floor)."""
+def cell_velocity_gradient(cfg: ti.template(), nd: ti.template(), xp, L):
+    """L with its trace replaced by the divergence at the centre of x_p's cell: the cell's
+    dilatation, the point's own shear (the explicit motion and the implicit residual alike)."""
+    div = cell_divergence(cfg, nd, xp)
+    return L + (div - L.trace()) / cfg.dim * ti.Matrix(IDENTITY[cfg.dim])
+
+
+@ti.func
+def cell_pressure_force(cfg: ti.template(), nd: ti.template(), target: ti.template(), xp, V, sig):
+    """-V mean_stress grad N at the centre of x_p's cell onto its corners in ``target`` (the
+    explicit step's nd.pressure_force, before the floor; the implicit step's internal force,
+    through the floored gradient); returns the deviator, whose force goes through the point's
+    own gradients. The mean is the in-plane one in 2D (trace / dim), as the cell's divergence
+    is."""
+    mean_stress = sig.trace() / cfg.dim
     c = point_cell(cfg, xp)
+    rest, mass = light_corners(cfg, nd, c)
     for o in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
-        scatter_add(cfg, nd.pressure_force, c + o, -V * mean_stress * corner_gradient(cfg, o))
+        g = cell_gradient(cfg, nd, c, o, rest, mass)
+        scatter_add(cfg, target, c + o, -V * mean_stress * g)
+    return sig - mean_stress * ti.Matrix(IDENTITY[cfg.dim])
 
 
 @ti.func

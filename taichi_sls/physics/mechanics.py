@@ -33,7 +33,7 @@ through the same gradient (physics/dilatation.py).
 from taichi_sls.backend import ti
 
 from .codes import Transfer, WallMechanical
-from .dilatation import cell_divergence, scatter_pressure_force
+from .dilatation import cell_pressure_force, cell_velocity_gradient
 from .grid import node_x, scatter_add
 from .shape import STENCIL_SHAPE, node_weight
 from .small_matrix import IDENTITY, ZERO_MATRIX, ZERO_VECTOR
@@ -65,9 +65,7 @@ def p2g_mechanics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, b
         if ti.static(cfg.solvent):
             sig += pt.viscous_stress[p]  # the melt's solvent viscosity: force only
         if ti.static(cfg.cell_dilatation):  # the mean stress through the cell's gradient
-            mean_stress = sig.trace() / cfg.dim
-            sig -= mean_stress * ti.Matrix(IDENTITY[cfg.dim])
-            scatter_pressure_force(cfg, nd, xp, Vp, mean_stress)
+            sig = cell_pressure_force(cfg, nd, nd.pressure_force, xp, Vp, sig)
     g = ti.Vector(cfg.gravity, dt=float)
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[cfg.dim])):
         N, gN = node_weight(w, dw, o)
@@ -181,8 +179,7 @@ def g2p_kinematics(cfg: ti.template(), pt: ti.template(), nd: ti.template(), p, 
     """
     v_grid, L = interpolate_velocity(cfg, nd, base, w, dw)
     if ti.static(cfg.cell_dilatation):  # the cell's dilatation, the point's own shear
-        div = cell_divergence(cfg, nd, pt.x[p])
-        L += (div - L.trace()) / cfg.dim * ti.Matrix(IDENTITY[cfg.dim])
+        L = cell_velocity_gradient(cfg, nd, pt.x[p], L)
     pt.x[p] += dt * v_grid
     F = (ti.Matrix(IDENTITY[cfg.dim]) + dt * L) @ pt.F[p]
     pt.F[p] = F

@@ -27,6 +27,7 @@ the identity in the components and lives as scalar rows ``K[I, I_j - I_i + 2]``.
 
 from taichi_sls.backend import ti
 
+from .dilatation import CELL_CORNERS, cell_gradient, light_corners, point_cell
 from .shape import node_weight, stencil
 from .small_matrix import ZERO_MATRIX
 from .surface_energy import GAUSS, outline_segments, outline_triangles
@@ -77,6 +78,39 @@ def scatter_point_tangent(cfg: ti.template(), K: ti.template(), base, w, dw, V, 
                 if ti.static(a == b):
                     k += a_mu * gg
                 K[base + oi, d, a, b] += V * k
+
+
+@ti.func
+def scatter_tangent(
+    cfg: ti.template(), K: ti.template(), nd: ti.template(), base, w, dw, xp, V, a_lam, a_mu
+):
+    """One point's tangent. With ``solver.dilatation = "cell"`` (physics/dilatation.py) the
+    point's stress is kappa div_c 1 + 2 a_mu dev(D_p), div_c the divergence at its cell's
+    centre, its mean acting through the cell's gradient: the deviatoric part through the point's
+    own gradients (the law above with a_lambda = -2 a_mu / dim) and the volumetric one,
+    V kappa g_i g_j^T with kappa = a_lambda + 2 a_mu / dim (the in-plane mean in 2D), over the
+    cell's 2^dim corners, g the floored gradient the force takes (physics/dilatation.py). Both
+    parts are symmetric and positive semi-definite."""
+    if ti.static(cfg.cell_dilatation):
+        scatter_point_tangent(cfg, K, base, w, dw, V, -2.0 * a_mu / cfg.dim, a_mu)
+        scatter_cell_tangent(cfg, K, nd, xp, V * (a_lam + 2.0 * a_mu / cfg.dim))
+    else:
+        scatter_point_tangent(cfg, K, base, w, dw, V, a_lam, a_mu)
+
+
+@ti.func
+def scatter_cell_tangent(cfg: ti.template(), K: ti.template(), nd: ti.template(), xp, kappa_V):
+    """K_ij += kappa V g_i g_j^T over the corners i, j of x_p's cell, g the corner's gradient that
+    the cell's divergence takes: the corners lie in the point's stencil, so within the row's
+    REACH."""
+    c = point_cell(cfg, xp)
+    rest, mass = light_corners(cfg, nd, c)
+    for i in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
+        gi = cell_gradient(cfg, nd, c, i, rest, mass)
+        for j in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
+            gj = cell_gradient(cfg, nd, c, j, rest, mass)
+            for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+                K[c + i, j - i + REACH, a, b] += kappa_V * gi[a] * gj[b]
 
 
 @ti.func

@@ -40,6 +40,7 @@ from taichi_sls.backend import ti
 from ..config import Case
 from ..physics.codes import SurfaceMethod
 from ..physics.constitutive import trial_stress
+from ..physics.dilatation import cell_pressure_force, cell_velocity_gradient
 from ..physics.grid import active, ramped_gamma
 from ..physics.mechanics import apply_walls, interpolate_velocity
 from ..physics.shape import STENCIL_SHAPE, node_weight
@@ -48,7 +49,7 @@ from ..physics.stiffness import (
     WIDTH,
     capillary_tangent,
     scatter_mass,
-    scatter_point_tangent,
+    scatter_tangent,
     stencil_offset,
 )
 from . import checkpoint, struct_copy
@@ -149,8 +150,12 @@ def _point_force(st: ti.template(), p):
     dt = st.scalars.dt[None]
     base, w, dw = point_stencil(st.cfg, pt, p)
     v_grid, L = interpolate_velocity(st.cfg, st.nodes, base, w, dw)
+    if ti.static(st.cfg.cell_dilatation):  # the cell's dilatation, as the explicit step's
+        L = cell_velocity_gradient(st.cfg, st.nodes, pt.x[p], L)
     sig, mu_t, K, eta = trial_stress(st.cfg, pt, st.materials, p, L, dt)
     V = pt.volume0[p] * pt.J[p]
+    if ti.static(st.cfg.cell_dilatation):  # the mean stress through the cell's gradient
+        sig = cell_pressure_force(st.cfg, st.nodes, st.implicit.internal, pt.x[p], V, sig)
     for o in ti.grouped(ti.ndrange(*STENCIL_SHAPE[st.cfg.dim])):
         N, gN = node_weight(w, dw, o)
         st.implicit.internal[base + o] += -V * (sig @ gN)
@@ -166,7 +171,8 @@ def _force_body(st: ti.template(), p, blk, heat: ti.template(), geom: ti.templat
         if ti.static(st.cfg.matrix_free):  # kept per point, applied by solver/multigrid.py
             st.implicit.moduli[p] = ti.Vector([V, a_lam, a_mu])
         else:
-            scatter_point_tangent(st.cfg, st.implicit.tangent, base, w, dw, V, a_lam, a_mu)
+            xp = st.points.x[p]
+            scatter_tangent(st.cfg, st.implicit.tangent, st.nodes, base, w, dw, xp, V, a_lam, a_mu)
 
 
 @ti.kernel

@@ -5,7 +5,7 @@ CG solves it, and a run with it takes the steps the direct solver takes."""
 import numpy as np
 import pytest
 
-from taichi_sls.config import case_from_dict
+from taichi_sls.config import CaseError, case_from_dict
 from taichi_sls.solver.multigrid import MatrixFreeSolver
 from taichi_sls.solver.simulation import Simulation
 
@@ -91,3 +91,11 @@ def test_steps_match_the_direct_solver():
         assert sim.implicit.last.solver == solver
     h = 4e-6
     assert np.abs(positions["direct"] - positions["matrix_free"]).max() <= 1e-5 * h
+
+
+def test_refused_with_the_cells_dilatation():
+    """The operator holds each point's own tangent, not the cell's volumetric one."""
+    case = pair(2, 4.0, "matrix_free")
+    case["solver"] = {"dilatation": "cell"}
+    with pytest.raises(CaseError, match='linear_solver = "matrix_free"'):
+        case_from_dict(case)

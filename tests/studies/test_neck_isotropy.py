@@ -4,8 +4,9 @@ per-contact neck r_n / R0 at the same times. The bars are those the isotropy was
 5 % between angles at the beds' resolution (R0/h = 5, a 2 um fillet under a 4 um cell), 2 % at
 R0/h = 20 (a 1 um fillet) and 3 % from Hopper there. With each point's own dilatation (the
 default) they are not met: strict xfails. With one dilatation per cell
-(``solver.dilatation = "cell"``, an option of explicit steps) the tests below hold what it
-meets. And the trend grows with how nearly incompressible the fluid is (volumetric locking)."""
+(``solver.dilatation = "cell"``, an option of the explicit and implicit steps) the tests below
+hold what it meets. And the trend grows with how nearly incompressible the fluid is
+(volumetric locking)."""
 
 import numpy as np
 import pytest
@@ -73,18 +74,45 @@ def test_cell_dilatation_grows_the_neck_alike_at_0_30_45_deg_at_the_beds_resolut
     assert _worst_ratio(runs) < 0.05
 
 
+IMPLICIT = {"time": {"integrator": "implicit"}}  # dt "auto": 50 explicit steps, 0.66 us here
+
+
+def test_cell_dilatation_grows_the_neck_alike_under_implicit_steps_at_the_beds_resolution():
+    """The same pair and bar (5 %, the beds' resolution) under implicit steps, as every bed case
+    grows its necks: measured 4.5 % (30 deg, its t = 0 reading) and 3.3 % (45 deg), one Newton
+    iteration a step; each point's own dilatation reads 8.1 % at 45 deg (the test below)."""
+    runs = _histories((0.0, 30.0, 45.0), 5.0, 2.0, deep_update(CELL, IMPLICIT))
+    for h in runs:
+        print(h.angle_deg, np.round(h.neck, 4))
+        assert h.neck[-1] > 1.5 * h.neck[0]
+    assert _worst_ratio(runs) < 0.05
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue #55 with each point's own dilatation: under implicit steps the 45 deg pair "
+    "at R0/h = 5 runs up to 8.1 % ahead of the pair along x",
+)
+def test_neck_grows_alike_under_implicit_steps_at_the_beds_resolution():
+    runs = _histories((0.0, 45.0), 5.0, 2.0, IMPLICIT)
+    print([np.round(h.neck, 4) for h in runs])
+    assert _worst_ratio(runs) < 0.05
+
+
 @pytest.mark.parametrize(
     "sets",
-    [
-        {"time": {"integrator": "implicit"}},
-        {"time": {"integrator": "hybrid"}},
-        {"solver": {"update": "musl"}},
-        {"boundary": {"right": {"mechanical": "mirror"}}},
-    ],
+    [{"solver": {"update": "musl"}}, {"boundary": {"right": {"mechanical": "mirror"}}}],
 )
 def test_cell_dilatation_refused_where_it_is_not_taken(sets):
     with pytest.raises(CaseError, match="solver.dilatation"):
         fillet_pair(0.0, 5.0, 2.0, deep_update(CELL, sets))
+
+
+@pytest.mark.parametrize("integrator", ["implicit", "hybrid"])
+def test_cell_dilatation_is_taken_by_the_implicit_and_hybrid_steps(integrator):
+    vc = fillet_pair(0.0, 5.0, 2.0, deep_update(CELL, {"time": {"integrator": integrator}}))
+    assert vc.case.solver.dilatation == "cell"
 
 
 @pytest.mark.slow
@@ -95,6 +123,22 @@ def test_cell_dilatation_follows_hopper_and_grows_alike_at_R0_h_20():
     for h in runs:
         errors = hopper_errors(h, (0.5, 0.75, 1.0), 0.35)
         print(h.angle_deg, np.round(h.neck, 4), {k: round(v, 4) for k, v in errors.items()})
+        assert all(abs(e) < 0.03 for e in errors.values())
+    assert worst < WORST_R20_CELL
+
+
+@pytest.mark.slow
+def test_cell_dilatation_follows_hopper_and_grows_alike_under_implicit_steps_at_R0_h_20():
+    """The R0/h = 20 bars (2 % between 0 and 45 deg, 3 % from Hopper with clocks aligned) under
+    implicit steps of 50 explicit ones, no light-node floor (the implicit step's tangent keeps
+    its symmetry without one)."""
+    runs = _histories((0.0, 45.0), 20.0, 1.0, deep_update(CELL, IMPLICIT))
+    worst = _worst_ratio(runs)
+    print(f"worst 45 / 0 deg ratio - 1: {worst:.4f}")
+    for h in runs:
+        errors = hopper_errors(h, (0.5, 0.75, 1.0), 0.35)
+        print(h.angle_deg, np.round(h.neck, 4), {k: round(v, 4) for k, v in errors.items()})
+        print(f"  {h.steps} steps, {h.wall_s:.0f} s")
         assert all(abs(e) < 0.03 for e in errors.values())
     assert worst < WORST_R20_CELL
 
