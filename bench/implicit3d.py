@@ -151,11 +151,10 @@ def measure(
 
 def _host_bytes(sim: Simulation, A) -> int:
     """The host's arrays of the step being solved: the Newton matrix (assembled) or the
-    multigrid's levels and the fixed part's CSR matrix (matrix-free), and the point moduli."""
+    multigrid's levels (matrix-free)."""
     linear = sim.implicit.linear
     if isinstance(linear, MatrixFreeSolver):
-        F = linear.multigrid.fixed
-        return linear.multigrid.nbytes + F.data.nbytes + F.indices.nbytes + F.indptr.nbytes
+        return linear.multigrid.nbytes  # the fixed part stays in the grid's rows
     return A.data.nbytes + A.indices.nbytes + A.indptr.nbytes
 
 

@@ -287,6 +287,12 @@ class Case(Model):
                 'remaps; allowed with it: solver.update = "usl" (any time.integrator), or '
                 'dilatation = "point"'
             )
+        if self.time.linear_solver == "matrix_free" and self.time.implicit_velocity_penalty > 0:
+            raise CaseError(
+                f"time.implicit_velocity_penalty = {self.time.implicit_velocity_penalty:g} with "
+                'time.linear_solver = "matrix_free": the penalty is added to assembled rows; '
+                'allowed with it: 0, or linear_solver = "auto", "direct" or "amg"'
+            )
         if self.solver.dilatation == "cell" and self.time.linear_solver == "matrix_free":
             raise CaseError(
                 'solver.dilatation = "cell" with time.linear_solver = "matrix_free": the '

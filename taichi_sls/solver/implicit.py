@@ -56,7 +56,7 @@ from . import checkpoint, struct_copy
 from .fields import State, clear_rows
 from .guard import SimulationError
 from .implicit_heat import StepHeat
-from .implicit_system import GridSystem, Part, dof_index, gather
+from .implicit_system import FixedRows, GridSystem, Part, dof_index, gather
 from .linear_solve import LinearSolveError, LinearSolver, linear_solver
 from .loops import check_block, grow_box, in_order, point_loop, point_stencil
 from .multigrid import MatrixFreeSolver
@@ -297,6 +297,13 @@ class ImplicitStepper:
         dof[flat] = np.arange(n, dtype=np.int32)
         struct_copy.from_numpy(st.implicit.numbering, {"dof": dof.reshape(free.shape)})
         dof_node = np.ascontiguousarray(np.argwhere(free != 0).astype(np.int32))
+        if st.cfg.matrix_free:  # the fixed rows stay on the grid (implicit_system.FixedRows)
+            rhs, v0, none = np.empty(n), np.empty(n), np.empty((0, 0))
+            if n:
+                gather(st, dof_node, none.astype(np.int32), none, rhs, v0, Part.RHS)
+            empty = np.empty(0)
+            rows = FixedRows(st, dof_node)
+            return GridSystem(dof_node, empty, empty, empty, empty, rhs, v0, rows)
         cols = np.empty((n, self._slots), dtype=np.int32)
         fixed = np.empty((n, self._slots))
         rhs, v0 = np.empty(n), np.empty(n)
@@ -344,7 +351,7 @@ class ImplicitStepper:
         st = self.st
         how = linear_solver(self.case, sys_.n)
         if how == "matrix_free":
-            self.linear = MatrixFreeSolver.for_step(self.linear, st, sys_, self.penalty)
+            self.linear = MatrixFreeSolver.for_step(self.linear, st, sys_)
         elif self.linear is None or self.linear.how != how:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)

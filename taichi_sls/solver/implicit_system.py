@@ -39,6 +39,7 @@ class Part(enum.IntEnum):
     FIXED = 0
     TANGENT = 1
     FORCE = 2
+    RHS = 3  # the right-hand side and the first iterate alone (the matrix-free step's)
 
 
 @ti.kernel
@@ -54,13 +55,13 @@ def gather(
     """Row k of the fixed matrix or of the tangent (the WIDTH^dim x dim slots of node-component
     k; cols -1 where the neighbour's component is not an unknown) and a vector, as ``part``
     (:class:`Part`) says: FIXED the columns, the right-hand side m v^n / dt + f into vec and v^n
-    into guess; TANGENT and FORCE the internal force into vec. One kernel for the three (a
-    template per part would compile three)."""
+    into guess; TANGENT and FORCE the internal force into vec; RHS the right-hand side and v^n
+    alone. One kernel for the four (a template per part would compile four)."""
     nd = ti.static(st.nodes)
     for k in range(vec.shape[0]):
         I = dof_index(st, dof_node, k)
         a = dof_node[k, st.cfg.dim]
-        if part != Part.FORCE:
+        if part == Part.FIXED or part == Part.TANGENT:
             for r in range(WIDTH**st.cfg.dim):  # the row's nodes, the last axis fastest
                 o, J, inside = row_neighbour(st.implicit.dof, I, r)
                 for b in ti.static(range(st.cfg.dim)):
@@ -78,11 +79,55 @@ def gather(
                     vals[k, slot] = value
                     if part == Part.FIXED:
                         cols[k, slot] = c
-        if part == Part.FIXED:
+        if part == Part.FIXED or part == Part.RHS:
             vec[k] = nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]
             guess[k] = nd.v[I][a]
         else:
             vec[k] = st.implicit.internal[I][a]
+
+
+@ti.kernel
+def fixed_product(
+    st: ti.template(),
+    dof_node: ti.types.ndarray(),
+    x: ti.types.ndarray(),
+    y: ti.types.ndarray(),
+    diagonal: ti.i32,
+):
+    """y = F x over the unknowns, F the fixed part's rows as the grid holds them (a scalar per
+    neighbour times the identity), without gathering them; ``diagonal``: y = F's diagonal."""
+    for k in range(y.shape[0]):
+        I = dof_index(st, dof_node, k)
+        a = dof_node[k, st.cfg.dim]
+        total = 0.0
+        if diagonal:
+            total = st.implicit.fixed[I, ti.Vector([REACH] * st.cfg.dim)]
+        else:
+            for r in range(WIDTH**st.cfg.dim):
+                o, J, inside = row_neighbour(st.implicit.dof, I, r)
+                if inside:
+                    c = st.implicit.dof[J][a]
+                    if c >= 0:
+                        total += st.implicit.fixed[I, o] * x[c]
+        y[k] = total
+
+
+class FixedRows:
+    """The fixed part as an operator on the unknowns (``F @ x``, ``F.diagonal()``), read from
+    the grid's rows where they are (the matrix-free step: no CSR copy on the host)."""
+
+    def __init__(self, st, dof_node: np.ndarray) -> None:
+        self.st, self.dof_node = st, dof_node
+
+    def __matmul__(self, x: np.ndarray) -> np.ndarray:
+        y = np.empty(len(self.dof_node))
+        fixed_product(self.st, self.dof_node, np.ascontiguousarray(x), y, 0)
+        return y
+
+    def diagonal(self) -> np.ndarray:
+        y = np.empty(len(self.dof_node))
+        fixed_product(self.st, self.dof_node, y, y, 1)
+        return y
 
 
 @dataclass
@@ -100,15 +145,16 @@ class GridSystem:
     fixed: np.ndarray  # inertia and capillary stiffness, on the stored entries
     rhs: np.ndarray  # m v^n / dt + f^ext + f^cap
     v0: np.ndarray  # v^n (walls applied): Newton's first iterate
+    rows: FixedRows | None = None  # the fixed part on the grid (matrix-free: nothing gathered)
 
     @property
     def n(self) -> int:
         return len(self.rhs)
 
     @cached_property
-    def fixed_matrix(self) -> sp.csr_matrix:
+    def fixed_matrix(self) -> "sp.csr_matrix | FixedRows":
         """The fixed part alone, which every residual evaluation multiplies."""
-        return self.matrix(self.fixed)
+        return self.rows if self.rows is not None else self.matrix(self.fixed)
 
     def matrix(self, values: np.ndarray) -> sp.csr_matrix:
         A = sp.csr_matrix((values, self.indices, self.indptr), shape=(self.n, self.n))

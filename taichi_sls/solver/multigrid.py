@@ -1,8 +1,8 @@
 """The implicit step's Newton systems without assembled tangent rows (``time.linear_solver =
 "matrix_free"``): conjugate gradients preconditioned by a geometric multigrid on the MPM grid.
 
-The operator. A x = F x + K x: F the fixed part (inertia, capillary stiffness, the velocity
-penalty: scalar rows times the identity, solver/implicit_system.py), K the points' tangent
+The operator. A x = F x + K x: F the fixed part (inertia, capillary stiffness: scalar rows
+times the identity, read on the grid, solver/implicit_system.py FixedRows), K the points' tangent
 applied through the points (physics/tangent_operator.py), so that the tangent costs three
 numbers a point instead of 375 entries a node row.
 
@@ -33,7 +33,7 @@ from ..physics.tangent_operator import (
     points_quadrature,
 )
 from .fields import State
-from .implicit_system import GridSystem
+from .implicit_system import FixedRows, GridSystem
 from .linear_solve import CG_MAX_ITERATIONS, LinearSolveError, SolveStats
 
 # the relative residual of each Newton direction, as the assembled solves' (solver/implicit.py
@@ -92,7 +92,7 @@ class Level:
 class GridMultigrid:
     """The operator and its V-cycle for one Newton tangent of one step (module docstring)."""
 
-    def __init__(self, st: State, dof_node: np.ndarray, fixed: sp.csr_matrix) -> None:
+    def __init__(self, st: State, dof_node: np.ndarray, fixed: FixedRows) -> None:
         self.st = st
         cfg = st.cfg
         self.dim = cfg.dim
@@ -367,42 +367,28 @@ def _masked_inverse(diag: np.ndarray, free: np.ndarray) -> np.ndarray:
 class MatrixFreeSolver:
     """The implicit step's linear solves for one step without assembled tangent rows (module
     docstring): the interface of solver/linear_solve.py's LinearSolver, the matrix argument
-    unused (the multigrid holds the points' tangent last taken). ``penalty``: the
-    time.implicit_velocity_penalty fraction, added to the fixed part at the step's first
-    tangent, scaled by the largest diagonal entry as the assembled step does."""
+    unused (the multigrid holds the points' tangent last taken)."""
 
     how = "matrix_free"
 
-    def __init__(self, st: State, sys_: GridSystem, penalty: float, rtol: float) -> None:
-        self.sys_ = sys_
-        self.penalty = penalty
+    def __init__(self, st: State, sys_: GridSystem, rtol: float = LINEAR_RTOL) -> None:
         self.rtol = rtol
         self.stats = SolveStats()
         self.multigrid = GridMultigrid(st, sys_.dof_node, sys_.fixed_matrix)
 
     @classmethod
-    def for_step(
-        cls, previous: object, st: State, sys_: GridSystem, penalty: float
-    ) -> "MatrixFreeSolver":
+    def for_step(cls, previous: object, st: State, sys_: GridSystem) -> "MatrixFreeSolver":
         """The solver of a new step's system, its counts going on from ``previous``'s where
-        that was one (the run records them), at the implicit step's linear tolerance."""
-        solver = cls(st, sys_, penalty, LINEAR_RTOL)
+        that was one (the run records them)."""
+        solver = cls(st, sys_)
         if isinstance(previous, cls):
             solver.stats = previous.stats
         return solver
 
     def set_tangent(self) -> None:
         """Take the points' moduli the force pass just kept."""
-        mg = self.multigrid
-        mg.set_tangent()
+        self.multigrid.set_tangent()
         self.stats.factorizations += 1
-        if self.penalty > 0.0:
-            diagonal = mg.levels[0].diagonal[mg.unknown_node, mg.unknown_comp, mg.unknown_comp]
-            stiffest = np.abs(diagonal).max()
-            self.sys_.add_to_fixed(self.penalty * stiffest * self.sys_.second_differences())
-            mg.fixed = self.sys_.fixed_matrix
-            self.penalty = 0.0  # once a step, as the assembled step adds it
-            mg.set_tangent()
 
     def solve(self, A: None, b: np.ndarray, refresh: bool = False) -> np.ndarray:
         self.stats.solves += 1

@@ -50,7 +50,7 @@ def test_operator_is_the_assembled_newton_matrix(dim):
     want = sys_.matrix(sys_.fixed + tangent) @ x
     sim, sys_mf, none = _newton_system(pair(dim, 4.0, "matrix_free", dt_s=1e-3))
     assert none is None  # no rows assembled
-    solver = MatrixFreeSolver(sim.state, sys_mf, 0.0, 1e-6)
+    solver = MatrixFreeSolver(sim.state, sys_mf)
     solver.set_tangent()
     mg = solver.multigrid
     got = mg.sparse(mg.apply(0, mg.dense(x)))
@@ -65,7 +65,7 @@ def test_multigrid_iterations_do_not_grow_with_the_grid():
     iterations = {}
     for h in (2.0, 1.0):
         sim, sys_, _ = _newton_system(pair(2, h, "matrix_free", dt_s=1e-2))
-        solver = MatrixFreeSolver(sim.state, sys_, 0.0, 1e-6)
+        solver = MatrixFreeSolver(sim.state, sys_)
         solver.set_tangent()
         b = np.random.default_rng(1).standard_normal(sys_.n)
         x = solver.solve(None, b)
@@ -98,4 +98,12 @@ def test_refused_with_the_cells_dilatation():
     case = pair(2, 4.0, "matrix_free")
     case["solver"] = {"dilatation": "cell"}
     with pytest.raises(CaseError, match='linear_solver = "matrix_free"'):
+        case_from_dict(case)
+
+
+def test_refused_with_the_velocity_penalty():
+    """The penalty is added to assembled rows, which the matrix-free step does not gather."""
+    case = pair(2, 4.0, "matrix_free")
+    case["time"]["implicit_velocity_penalty"] = 1e-6
+    with pytest.raises(CaseError, match="time.implicit_velocity_penalty"):
         case_from_dict(case)
