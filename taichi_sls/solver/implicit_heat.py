@@ -205,7 +205,7 @@ class StepHeat:
                 shape=(n, n),
             )
             A.has_sorted_indices = True
-            how = linear_solver(self.case, n)
+            how = linear_solver(self.case, n, assembled=True)
             if self.linear is None or self.linear.how != how:
                 self.linear = LinearSolver(how, HEAT_RTOL)
             dT = self.linear.solve(A, rhs)

@@ -46,10 +46,12 @@ def direct_max_unknowns(case: Case) -> int:
     return DIRECT_MAX_UNKNOWNS[case.domain.dim] if limit is None else limit
 
 
-def linear_solver(case: Case, n: int) -> str:
-    """The solver for n unknowns: ``time.linear_solver``, "auto" by size."""
+def linear_solver(case: Case, n: int, assembled: bool = False) -> str:
+    """The solver for n unknowns: ``time.linear_solver``, "auto" by size; ``assembled``: a
+    system whose rows are assembled anyway (the backward-Euler heat's), where "matrix_free"
+    reads as "auto"."""
     choice = case.time.linear_solver
-    if choice == "auto":
+    if choice == "auto" or (assembled and choice == "matrix_free"):
         choice = "direct" if n <= direct_max_unknowns(case) else "amg"
     return choice
 

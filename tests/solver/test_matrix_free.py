@@ -107,3 +107,17 @@ def test_refused_with_the_velocity_penalty():
     case["time"]["implicit_velocity_penalty"] = 1e-6
     with pytest.raises(CaseError, match="time.implicit_velocity_penalty"):
         case_from_dict(case)
+
+
+def test_a_hybrid_run_with_heat_takes_it(tmp_path):
+    """The hybrid pair with backward-Euler heat: the mechanics' solves are matrix-free, the
+    heat's (assembled anyway) take the direct solver; the run records the mechanics' solver."""
+    from taichi_sls.config import load_case
+    from taichi_sls.jobs.case_run import run_case
+
+    sets = ["grid.spacing_um=4", "time.stop=end", "time.end_s=4e-5", "output.png=false"]
+    sets += ["output.gif=false", "time.linear_solver=matrix_free"]
+    summary = run_case(load_case("power25W_resolved", sets), tmp_path, progress=False)
+    assert summary["status"] == "complete"
+    assert summary["linear_solves"]["solver"] == "matrix_free"
+    assert summary["linear_solves"]["cg_iterations"] > 0
