@@ -40,7 +40,7 @@ def _newton_system(case: dict):
     return sim, sys_, tangent
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [2, pytest.param(3, marks=pytest.mark.slow)])
 def test_operator_is_the_assembled_newton_matrix(dim):
     """A x through the points equals the assembled (fixed + tangent) x: the same sums in
     another order, so to round-off (1e-12 relative)."""
@@ -57,6 +57,7 @@ def test_operator_is_the_assembled_newton_matrix(dim):
     assert np.linalg.norm(got - want) <= 1e-12 * np.linalg.norm(want)
 
 
+@pytest.mark.slow  # ~16 s
 def test_multigrid_iterations_do_not_grow_with_the_grid():
     """CG with the V-cycle reaches 1e-6 in about as many iterations on a grid twice as fine
     (a multigrid's property; unpreconditioned CG's count would double): within 1.5x, with a
@@ -109,6 +110,7 @@ def test_refused_with_the_velocity_penalty():
         case_from_dict(case)
 
 
+@pytest.mark.slow  # ~17 s
 def test_a_hybrid_run_with_heat_takes_it(tmp_path):
     """The hybrid pair with backward-Euler heat: the mechanics' solves are matrix-free, the
     heat's (assembled anyway) take the direct solver; the run records the mechanics' solver."""

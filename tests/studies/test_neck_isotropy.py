@@ -77,6 +77,7 @@ def test_cell_dilatation_grows_the_neck_alike_at_0_30_45_deg_at_the_beds_resolut
 IMPLICIT = {"time": {"integrator": "implicit"}}  # dt "auto": 50 explicit steps, 0.66 us here
 
 
+@pytest.mark.slow  # ~30 s; the explicit step's counterpart stays in the default suite
 def test_cell_dilatation_grows_the_neck_alike_under_implicit_steps_at_the_beds_resolution():
     """The same pair and bar (5 %, the beds' resolution) under implicit steps, as every bed case
     grows its necks: measured 4.5 % (30 deg, its t = 0 reading) and 3.5 % (45 deg), one Newton

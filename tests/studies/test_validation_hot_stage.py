@@ -80,6 +80,7 @@ def test_the_scaling_gap_is_zero_for_one_law_and_not_for_another():
     assert scaling_gap(_hopper_run(32.0, 200.0), slow)["tau_rel_at_0.5"] > 0.05
 
 
+@pytest.mark.slow  # ~60 s: two pair runs
 def test_the_scaled_pair_seeds_the_same_neck_at_any_radius(tmp_path):
     """Every length of the case scales with R, so two radii seed the same points in units of R:
     the first a / R is the same (1e-9), whatever the temperature."""
