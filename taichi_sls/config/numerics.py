@@ -156,6 +156,15 @@ class Time(Model):
         "preconditioned by a geometric multigrid on the MPM grid: solver/multigrid.py) or "
         "auto (direct up to direct_max_unknowns grid velocity components, amg above)",
     )
+    refactorize: Literal["each_tangent", "when_slow"] = Field(
+        "each_tangent",
+        description='implicit, linear_solver = "direct": each_tangent (every tangent Newton '
+        "takes is factorized afresh and solved with directly, the reference) or when_slow "
+        "(the factorization kept from an earlier tangent, of this or an earlier step, "
+        "preconditions conjugate gradients on the new one, over the unknowns the two share; "
+        "a new factorization only where CG needs more than 20 iterations: "
+        "docs/record/implicit.md)",
+    )
     direct_max_unknowns: int | None = Field(
         None,
         ge=1,

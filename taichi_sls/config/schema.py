@@ -46,6 +46,10 @@ __all__ = ["Bed", "Body", "Case", "Disc", "Material", "MAX_CELLS", "Pair"]
 NO_BODIES = "at least one [[bodies]] table or a [bed] table is required"
 
 
+# time.linear_solver values with no direct factorization to keep (time.refactorize)
+KEEPS_NO_FACTOR = ("amg", "matrix_free")
+
+
 class Case(Model):
     case: CaseInfo = Field(default_factory=CaseInfo)
     grid: Grid = Field(default_factory=Grid)
@@ -299,6 +303,13 @@ class Case(Model):
                 "matrix-free tangent is each point's own (solver/multigrid.py), not the cell's "
                 'volumetric part; allowed with it: linear_solver = "auto", "direct" or "amg", or '
                 'dilatation = "point"'
+            )
+        if self.time.refactorize == "when_slow" and self.time.linear_solver in KEEPS_NO_FACTOR:
+            raise CaseError(
+                f'time.refactorize = "when_slow" with time.linear_solver = '
+                f'"{self.time.linear_solver}": only a direct factorization is kept across '
+                'tangents; allowed with it: linear_solver = "auto" or "direct", or refactorize '
+                '= "each_tangent"'
             )
         folded = [
             w.mechanical

@@ -356,6 +356,7 @@ class ImplicitStepper:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
             self.linear.near_null = sys_.rigid_body_modes()
+        kept = self.case.time.refactorize == "when_slow"
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)
         if self.penalty > 0.0 and how != "matrix_free":  # the light nodes' near-null modes
@@ -375,7 +376,7 @@ class ImplicitStepper:
                     "time.implicit_velocity_penalty = 1e-6"
                 )
             try:
-                dv = self.linear.solve(A, -R, refresh=fresh)
+                dv = self.linear.solve(A, -R, refresh=fresh and not kept, keys=sys_.keys)
             except LinearSolveError as e:  # an adaptive run redoes the step smaller
                 raise NewtonError(
                     f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "

@@ -33,7 +33,7 @@ from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
 from ..physics.thermal import fixed_temperature, point_conductivity
 from . import struct_copy
 from .fields import State
-from .implicit_system import row_neighbour
+from .implicit_system import row_neighbour, unknown_keys
 from .linear_solve import LinearSolver, linear_solver
 from .loops import in_order, point_loop, point_stencil
 from .step import (
@@ -208,6 +208,7 @@ class StepHeat:
             how = linear_solver(self.case, n, assembled=True)
             if self.linear is None or self.linear.how != how:
                 self.linear = LinearSolver(how, HEAT_RTOL)
-            dT = self.linear.solve(A, rhs)
+            kept = self.case.time.refactorize == "when_slow"
+            dT = self.linear.solve(A, rhs, keys=unknown_keys(nodes) if kept else None)
             rows_or_flow(st, nodes, cols, vals, np.ascontiguousarray(dT, dtype=np.float64), False)
         in_order(st, finish)

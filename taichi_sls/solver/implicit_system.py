@@ -32,6 +32,21 @@ def dof_index(st: ti.template(), dof_node: ti.template(), k):
     return ti.Vector([dof_node[k, a] for a in ti.static(range(st.cfg.dim))])
 
 
+KEY_BITS = 20  # GridSystem.keys: the bits of a node index along one axis
+
+
+def unknown_keys(nodes: np.ndarray, component: np.ndarray | None = None) -> np.ndarray:
+    """Each unknown (node ``nodes[k]``, its component ``component[k]``) as one integer,
+    ascending as the unknowns are numbered (node index order, the last axis fastest, then the
+    component): the same unknown has the same key in every step of a run (LinearSolver.solve).
+    2^KEY_BITS nodes an axis at most."""
+    dim = nodes.shape[1]
+    key = np.zeros(len(nodes), dtype=np.int64)
+    for a in range(dim):
+        key = (key << KEY_BITS) + nodes[:, a]
+    return key if component is None else key * dim + component
+
+
 class Part(enum.IntEnum):
     """What :func:`gather` reads: the fixed matrix with its columns, the right-hand side and
     the first iterate; the points' tangent and the internal force; the internal force alone."""
@@ -200,6 +215,12 @@ class GridSystem:
         values = np.zeros(len(self.indices))
         np.add.at(values, where, np.concatenate(vals))
         return values
+
+    @cached_property
+    def keys(self) -> np.ndarray:
+        """Each unknown as one integer (:func:`unknown_keys`)."""
+        dim = self.dof_node.shape[1] - 1
+        return unknown_keys(self.dof_node[:, :dim], self.dof_node[:, dim])
 
     def rigid_body_modes(self) -> np.ndarray:
         """The grid velocities of rigid motions at the unknowns, one column each: dim

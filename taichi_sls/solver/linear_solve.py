@@ -24,11 +24,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 
 from ..config import Case
 
 CG_MAX_ITERATIONS = 500
+# LinearSolver._mapped: the most unknowns leaving the system whose effect on the kept
+# factorization is corrected exactly (a solve each)
+WOODBURY_MAX = 64
+# preconditioned_cg(predict=True): the iterations after which it judges its rate
+PREDICT_AFTER = 5
 
 
 class LinearSolveError(RuntimeError):
@@ -83,27 +89,57 @@ class LinearSolver:
         # amg: the matrix's near-null modes (columns), which smoothed aggregation keeps exact
         # on its coarse levels; None: the constant vector (pyamg's default)
         self.near_null: np.ndarray | None = None
+        self._keys: np.ndarray | None = None  # the factorized matrix's unknowns (ascending)
+        self._map: tuple | None = None  # (keys, preconditioner) of _mapped's last call
+        self._kept_failed = False  # the kept factorization failed the last matrix it met
 
-    def solve(self, A: sp.csr_matrix, b: np.ndarray, refresh: bool = False) -> np.ndarray:
+    def solve(
+        self,
+        A: sp.csr_matrix,
+        b: np.ndarray,
+        refresh: bool = False,
+        keys: np.ndarray | None = None,
+    ) -> np.ndarray:
         """x with |A x - b| <= rtol |b|; ``refresh``: factorize A afresh (direct: solve with it;
-        amg: a new hierarchy) even where the kept one would do."""
+        amg: a new hierarchy) even where the kept one would do. ``keys``: what each unknown is
+        (ascending integers, a node and component each): a direct factorization kept from
+        unknowns that were partly others then preconditions CG on the ones both share
+        (:meth:`_mapped`), so that a node entering or leaving the system does not cost a new
+        factorization while the kept one still contracts CG within ``refresh_after``
+        iterations."""
         self.stats.solves += 1
         if A is self._factored and self.how == "direct":
             return self._factor.solve(b)
         same = self._same_pattern(A)
-        fresh = refresh or not same
+        mapped = (
+            not same
+            and not refresh
+            and keys is not None
+            and self.how == "direct"
+            and self._keys is not None
+        )
+        fresh = refresh or not (same or mapped)
+        if keys is not None and not fresh and self._kept_failed:
+            # the kept factorization failed the last new matrix: this one is factorized
+            # afresh, the next tries the kept one again (a hold's steps change dt twofold)
+            fresh, self._kept_failed = True, False
         if fresh:
-            self._factorize(A, new_pattern=not same)
+            self._factorize(A, new_pattern=not same, keys=keys)
             if self.how == "direct":
                 return self._factor.solve(b)
         # a fresh hierarchy is not set up again: CG runs on to its limit with it (the same
         # iterates as a second set-up from the same matrix, at half the cost)
-        x, converged = self._cg(A, b, CG_MAX_ITERATIONS if fresh else self.refresh_after)
+        precondition = self._mapped(A, keys) if mapped else self._precondition
+        limit = CG_MAX_ITERATIONS if fresh else self.refresh_after
+        # with keys, CG on a kept factorization stops as soon as its rate of convergence
+        # shows it would not reach rtol within the limit
+        x, converged = self._cg(A, b, limit, precondition, keys is not None and not fresh)
         if not converged and not fresh:
-            self._factorize(A, new_pattern=False)
+            self._kept_failed = keys is not None
+            self._factorize(A, new_pattern=not same, keys=keys)
             if self.how == "direct":
                 return self._factor.solve(b)
-            x, converged = self._cg(A, b, CG_MAX_ITERATIONS)
+            x, converged = self._cg(A, b, CG_MAX_ITERATIONS, self._precondition)
         if not converged:
             raise LinearSolveError(
                 f"conjugate gradients with a fresh {self.how} preconditioner did not reach "
@@ -111,14 +147,56 @@ class LinearSolver:
             )
         return x
 
+    def _mapped(self, A: sp.csr_matrix, keys: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """The kept factorization of A_old as a preconditioner of A over other unknowns: on
+        the unknowns both share, the inverse of A_old's block there (symmetric positive
+        definite, as CG needs), from A_old^-1 by the Woodbury identity over the unknowns that
+        left (up to WOODBURY_MAX of them; beyond, A_old^-1's block there); on A's new
+        unknowns, the inverse of A's diagonal. Each unknown that left or entered otherwise
+        costs CG about one iteration. Kept for the next solve with the same ``keys``."""
+        if self._map is not None and self._map[0] is keys:
+            return self._map[1]
+        old = self._keys
+        at = np.minimum(np.searchsorted(old, keys), len(old) - 1)
+        shared = old[at] == keys
+        into = at[shared]
+        left = np.setdiff1d(np.arange(len(old)), into, assume_unique=True)
+        inverse_diagonal = 1.0 / A.diagonal()
+        solve = self._factor.solve
+        correct = None
+        if 0 < len(left) <= WOODBURY_MAX:
+            unit = np.zeros((len(old), len(left)))
+            unit[left, np.arange(len(left))] = 1.0
+            columns = self._factor.solve(unit)  # A_old^-1 at the unknowns that left
+            block = scipy.linalg.cho_factor(columns[left])
+
+            def correct(y: np.ndarray) -> np.ndarray:
+                return y - columns @ scipy.linalg.cho_solve(block, y[left])
+
+        def precondition(r: np.ndarray) -> np.ndarray:
+            full = np.zeros(len(old))
+            full[into] = r[shared]
+            y = solve(full)
+            if correct is not None:
+                y = correct(y)
+            z = r * inverse_diagonal
+            z[shared] = y[into]
+            return z
+
+        self._map = (keys, precondition)
+        return precondition
+
     def _same_pattern(self, A: sp.csr_matrix) -> bool:
         if self._pattern is None:
             return False
         indptr, indices = self._pattern
         return np.array_equal(indptr, A.indptr) and np.array_equal(indices, A.indices)
 
-    def _factorize(self, A: sp.csr_matrix, new_pattern: bool) -> None:
+    def _factorize(
+        self, A: sp.csr_matrix, new_pattern: bool, keys: np.ndarray | None = None
+    ) -> None:
         self.stats.factorizations += 1
+        self._keys, self._map = keys, None
         if self.how == "direct":
             try:
                 if new_pattern or self._factor is None:
@@ -126,7 +204,7 @@ class LinearSolver:
                 else:
                     self._factor.update(A)
             except LinearSolveError:  # nothing kept: the next matrix starts afresh
-                self._factor = self._factored = self._pattern = None
+                self._factor = self._factored = self._pattern = self._keys = None
                 raise
             self._precondition = self._factor.solve
         else:
@@ -140,8 +218,15 @@ class LinearSolver:
         self._pattern = (A.indptr.copy(), A.indices.copy())
         self._factored = A
 
-    def _cg(self, A: sp.csr_matrix, b: np.ndarray, limit: int) -> tuple[np.ndarray, bool]:
-        x, iterations, converged = preconditioned_cg(A, b, self._precondition, self.rtol, limit)
+    def _cg(
+        self,
+        A: sp.csr_matrix,
+        b: np.ndarray,
+        limit: int,
+        precondition: Callable[[np.ndarray], np.ndarray],
+        predict: bool = False,
+    ) -> tuple[np.ndarray, bool]:
+        x, iterations, converged = preconditioned_cg(A, b, precondition, self.rtol, limit, predict)
         self.stats.cg_iterations += iterations
         return x, converged
 
@@ -198,13 +283,16 @@ class DirectFactor:
         return self._ldl is None
 
     def solve(self, b: np.ndarray) -> np.ndarray:
+        """A^-1 b, b a vector or a matrix of columns."""
         if self._ldl is not None:
+            if b.ndim == 2:
+                return np.column_stack([self._ldl.solve(c) for c in b.T])
             return self._ldl.solve(b)
         from cvxopt import cholmod, matrix
 
-        x = matrix(b)
+        x = matrix(np.ascontiguousarray(b))
         cholmod.solve(self._symbolic, x)
-        return np.asarray(x).ravel()
+        return np.asarray(x).reshape(b.shape)
 
 
 def preconditioned_cg(
@@ -213,13 +301,16 @@ def preconditioned_cg(
     precondition: Callable[[np.ndarray], np.ndarray],
     rtol: float,
     limit: int,
+    predict: bool = False,
 ) -> tuple[np.ndarray, int, bool]:
     """Conjugate gradients from x = 0 to |b - A x| <= rtol |b| in at most ``limit``
     iterations: (x, iterations, converged). A and the preconditioner symmetric positive
-    definite."""
+    definite. ``predict``: give up after PREDICT_AFTER iterations where the residual's mean
+    rate of decrease so far would need more than ``limit`` in all."""
     x = np.zeros_like(b)
     r = b.copy()
-    target = rtol * np.linalg.norm(b)
+    norm_b = np.linalg.norm(b)
+    target = rtol * norm_b
     if np.linalg.norm(r) <= target:
         return x, 0, True
     z = precondition(r)
@@ -230,8 +321,13 @@ def preconditioned_cg(
         alpha = rz / (p @ Ap)
         x += alpha * p
         r -= alpha * Ap
-        if np.linalg.norm(r) <= target:
+        norm_r = np.linalg.norm(r)
+        if norm_r <= target:
             return x, k, True
+        if predict and k == PREDICT_AFTER:
+            rate = (norm_r / norm_b) ** (1.0 / k)
+            if rate >= 1.0 or np.log(rtol) / np.log(rate) > limit:
+                return x, k, False
         z = precondition(r)
         rz, rz_old = r @ z, rz
         p *= rz / rz_old

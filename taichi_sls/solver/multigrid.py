@@ -390,7 +390,10 @@ class MatrixFreeSolver:
         self.multigrid.set_tangent()
         self.stats.factorizations += 1
 
-    def solve(self, A: None, b: np.ndarray, refresh: bool = False) -> np.ndarray:
+    def solve(
+        self, A: None, b: np.ndarray, refresh: bool = False, keys: np.ndarray | None = None
+    ) -> np.ndarray:
+        """LinearSolver.solve's call; ``refresh`` and ``keys`` unused (a cycle a tangent)."""
         self.stats.solves += 1
         x, iterations, _ = self.multigrid.solve(b, self.rtol, CG_MAX_ITERATIONS)
         self.stats.cg_iterations += iterations

@@ -111,9 +111,8 @@ def plane_areas(
     n_t = math.ceil(reach / lat - 1e-9)
     t = lat * np.arange(-n_t, n_t + 1)
     plane = t[:, None, None] * u + t[None, :, None] * w  # (T, T, 3)
-    return np.array(
-        [section_area(trilinear(material, h, off, ca + sk * e + plane, -1.0), lat) for sk in s]
-    )
+    points = ca + np.asarray(s)[:, None, None, None] * e + plane  # (S, T, T, 3)
+    return section_areas(trilinear(material, h, off, points, -1.0), lat)
 
 
 SECTIONS: dict[int, Callable[..., np.ndarray]] = {2: line_widths, 3: plane_areas}
@@ -218,11 +217,22 @@ def _triangle_fraction(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarra
 def section_area(c: np.ndarray, step: float) -> float:
     """Area (m^2) where a field sampled on a square lattice of spacing ``step`` is >= 0, holes
     filled (marching triangles; the lattice's edge is outside)."""
-    solid = ndimage.binary_fill_holes(c >= 0.0)
+    return float(section_areas(c[None], step)[0])
+
+
+# binary_fill_holes within each plane of a stack, never across planes
+IN_PLANE = np.stack(
+    [np.zeros((3, 3), bool), ndimage.generate_binary_structure(2, 1), np.zeros((3, 3), bool)]
+)
+
+
+def section_areas(c: np.ndarray, step: float) -> np.ndarray:
+    """:func:`section_area` of each plane c[k] of a stack (S, T, T), in one pass."""
+    solid = ndimage.binary_fill_holes(c >= 0.0, structure=IN_PLANE)
     c = np.where(solid & (c < 0.0), 0.0, c)  # a hole's nodes count as material
-    sw, se, nw, ne = c[:-1, :-1], c[1:, :-1], c[:-1, 1:], c[1:, 1:]
+    sw, se, nw, ne = c[:, :-1, :-1], c[:, 1:, :-1], c[:, :-1, 1:], c[:, 1:, 1:]
     frac = _triangle_fraction(sw, se, ne) + _triangle_fraction(sw, ne, nw)
-    return float(0.5 * step * step * frac.sum())
+    return 0.5 * step * step * frac.sum(axis=(1, 2))
 
 
 def plane_basis(e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -188,6 +188,43 @@ def test_linear_solver_reuses_its_preconditioner(how):
     assert solver.stats.cg_iterations > 0
 
 
+def test_kept_factor_preconditions_a_system_over_other_unknowns():
+    """time.refactorize = "when_slow": a factorization kept from one set of unknowns
+    preconditions CG on a drifted matrix whose unknowns are partly other (some left, some
+    entered: a node's mass crossing the cut), reaching the residual asked with no new
+    factorization; with no keys, or asked to refresh, it factorizes afresh."""
+    n = 40
+    lap = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    full = (sp.kronsum(lap, lap) + 0.01 * sp.eye(n * n)).tocsr()
+    keys = np.arange(n * n, dtype=np.int64)
+    old = keys[keys % 397 != 5]  # 4 unknowns absent before ...
+    new = keys[keys % 389 != 3]  # ... 4 others absent after
+    A_old = full[old][:, old].tocsr()
+    A_new = full[new][:, new].tocsr()
+    A_new.data *= 1.0 + 0.02 * np.cos(np.arange(A_new.nnz))
+    A_new = ((A_new + A_new.T) * 0.5).tocsr()
+    b = np.random.default_rng(11).normal(size=len(new))
+    solver = LinearSolver("direct", rtol=1e-8)
+    solver.solve(A_old, np.ones(len(old)), refresh=True, keys=old)
+    x = solver.solve(A_new, b, keys=new)
+    assert np.linalg.norm(A_new @ x - b) <= 1e-8 * np.linalg.norm(b)
+    assert solver.stats.factorizations == 1
+    assert 0 < solver.stats.cg_iterations <= solver.refresh_after
+    # unknowns that only left: the Woodbury correction makes the kept factorization the exact
+    # inverse of what remains, one CG iteration
+    exact = LinearSolver("direct", rtol=1e-8)
+    exact.solve(full, np.ones(n * n), refresh=True, keys=keys)
+    remaining = keys[keys % 97 != 5]  # 17 left
+    A_left = full[remaining][:, remaining].tocsr()
+    x = exact.solve(A_left, b[: len(remaining)], keys=remaining)
+    assert np.linalg.norm(A_left @ x - b[: len(remaining)]) <= 1e-8 * np.linalg.norm(b)
+    assert exact.stats.factorizations == 1 and exact.stats.cg_iterations == 1
+    fresh = LinearSolver("direct", rtol=1e-8)
+    fresh.solve(A_old, np.ones(len(old)), refresh=True, keys=old)
+    fresh.solve(A_new, b)  # no keys: another pattern is factorized
+    assert fresh.stats.factorizations == 2 and fresh.stats.cg_iterations == 0
+
+
 def test_linear_solver_solves_a_refreshed_matrix_directly():
     """A fresh factorization solves its own matrix exactly, and the same matrix again without
     CG or a new factorization (the implicit step's kept tangent); ``preconditioned_cg`` with no
