@@ -165,6 +165,12 @@ class Time(Model):
         "a new factorization only where CG needs more than 20 iterations: "
         "docs/record/implicit.md)",
     )
+    direct_ordering: Literal["auto", "amd", "nested_dissection"] = Field(
+        "auto",
+        description="implicit, the direct solver's elimination order: amd (CHOLMOD's own), "
+        "nested_dissection (METIS's, through pymetis, on the graph of the grid nodes: less "
+        "fill on 3D rows; solver/ordering.py) or auto (nested_dissection in 3D, amd in 2D)",
+    )
     direct_max_unknowns: int | None = Field(
         None,
         ge=1,

@@ -57,7 +57,7 @@ from .fields import State, clear_rows
 from .guard import SimulationError
 from .implicit_heat import StepHeat
 from .implicit_system import FixedRows, GridSystem, Part, dof_index, gather
-from .linear_solve import LinearSolveError, LinearSolver, linear_solver
+from .linear_solve import LinearSolveError, LinearSolver, linear_solver, nested_ordering
 from .loops import check_block, grow_box, in_order, point_loop, point_stencil
 from .multigrid import MatrixFreeSolver
 from .step import (
@@ -356,6 +356,8 @@ class ImplicitStepper:
             self.linear = LinearSolver(how, LINEAR_RTOL)
         if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
             self.linear.near_null = sys_.rigid_body_modes()
+        if how == "direct" and nested_ordering(self.case):
+            self.linear.nodes = sys_.keys // st.cfg.dim
         kept = self.case.time.refactorize == "when_slow"
         v = sys_.v0
         f_int, tangent = self.internal(sys_, v)

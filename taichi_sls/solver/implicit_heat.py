@@ -34,7 +34,7 @@ from ..physics.thermal import fixed_temperature, point_conductivity
 from . import struct_copy
 from .fields import State
 from .implicit_system import row_neighbour, unknown_keys
-from .linear_solve import LinearSolver, linear_solver
+from .linear_solve import LinearSolver, linear_solver, nested_ordering
 from .loops import in_order, point_loop, point_stencil
 from .step import (
     clear_grid,
@@ -208,7 +208,10 @@ class StepHeat:
             how = linear_solver(self.case, n, assembled=True)
             if self.linear is None or self.linear.how != how:
                 self.linear = LinearSolver(how, HEAT_RTOL)
+            keys = unknown_keys(nodes)
+            if how == "direct" and nested_ordering(self.case):
+                self.linear.nodes = keys
             kept = self.case.time.refactorize == "when_slow"
-            dT = self.linear.solve(A, rhs, keys=unknown_keys(nodes) if kept else None)
+            dT = self.linear.solve(A, rhs, keys=keys if kept else None)
             rows_or_flow(st, nodes, cols, vals, np.ascontiguousarray(dT, dtype=np.float64), False)
         in_order(st, finish)

@@ -28,6 +28,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ..config import Case
+from .ordering import nested_dissection
 
 CG_MAX_ITERATIONS = 500
 # LinearSolver._mapped: the most unknowns leaving the system whose effect on the kept
@@ -50,6 +51,13 @@ def direct_max_unknowns(case: Case) -> int:
     """``time.direct_max_unknowns``, or where unset the dimension's DIRECT_MAX_UNKNOWNS."""
     limit = case.time.direct_max_unknowns
     return DIRECT_MAX_UNKNOWNS[case.domain.dim] if limit is None else limit
+
+
+def nested_ordering(case: Case) -> bool:
+    """Whether the direct factorizations order by nested dissection (``time.direct_ordering``;
+    "auto": in 3D)."""
+    choice = case.time.direct_ordering
+    return choice == "nested_dissection" or (choice == "auto" and case.domain.dim == 3)
 
 
 def linear_solver(case: Case, n: int, assembled: bool = False) -> str:
@@ -89,6 +97,9 @@ class LinearSolver:
         # amg: the matrix's near-null modes (columns), which smoothed aggregation keeps exact
         # on its coarse levels; None: the constant vector (pyamg's default)
         self.near_null: np.ndarray | None = None
+        # direct: each unknown's node (a label), where the factorization is ordered by nested
+        # dissection of the nodes' graph (time.direct_ordering); None: CHOLMOD's AMD
+        self.nodes: np.ndarray | None = None
         self._keys: np.ndarray | None = None  # the factorized matrix's unknowns (ascending)
         self._map: tuple | None = None  # (keys, preconditioner) of _mapped's last call
         self._kept_failed = False  # the kept factorization failed the last matrix it met
@@ -200,7 +211,8 @@ class LinearSolver:
         if self.how == "direct":
             try:
                 if new_pattern or self._factor is None:
-                    self._factor = DirectFactor(A)
+                    order = None if self.nodes is None else nested_dissection(A, self.nodes)
+                    self._factor = DirectFactor(A, order)
                 else:
                     self._factor.update(A)
             except LinearSolveError:  # nothing kept: the next matrix starts afresh
@@ -237,8 +249,11 @@ class DirectFactor:
     qdldl's simplicial LDL^T on the implicit step's matrices (docs/record/implicit.md); qdldl
     where Cholesky finds A not positive definite."""
 
-    def __init__(self, A: sp.csr_matrix) -> None:
+    def __init__(self, A: sp.csr_matrix, order: np.ndarray | None = None) -> None:
+        """``order``: the elimination order (solver/ordering.py); None: CHOLMOD's AMD."""
         from cvxopt import matrix, spmatrix
+
+        self._p = None if order is None else matrix(order.astype(np.int32).tolist())
 
         n = A.shape[0]
         rows = np.repeat(np.arange(n), np.diff(A.indptr))
@@ -263,7 +278,10 @@ class DirectFactor:
         self._ldl = None
         try:
             if self._symbolic is None:
-                self._symbolic = cholmod.symbolic(self._lower)
+                if self._p is None:
+                    self._symbolic = cholmod.symbolic(self._lower)
+                else:
+                    self._symbolic = cholmod.symbolic(self._lower, p=self._p)
             cholmod.numeric(self._lower, self._symbolic)
         except ArithmeticError:  # not positive definite: LDL^T, and a fresh analysis next time
             import qdldl
