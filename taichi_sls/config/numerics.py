@@ -162,7 +162,7 @@ class Time(Model):
         "takes is factorized afresh and solved with directly, the reference) or when_slow "
         "(the factorization kept from an earlier tangent, of this or an earlier step, "
         "preconditions conjugate gradients on the new one, over the unknowns the two share; "
-        "a new factorization only where CG needs more than 20 iterations: "
+        "a new factorization only where CG would need more than 20 iterations: "
         "docs/record/implicit.md)",
     )
     direct_ordering: Literal["auto", "amd", "nested_dissection"] = Field(

@@ -378,7 +378,9 @@ class ImplicitStepper:
                     "time.implicit_velocity_penalty = 1e-6"
                 )
             try:
-                dv = self.linear.solve(A, -R, refresh=fresh and not kept, keys=sys_.keys)
+                dv = self.linear.solve(
+                    A, -R, refresh=fresh and not kept, keys=sys_.keys if kept else None
+                )
             except LinearSolveError as e:  # an adaptive run redoes the step smaller
                 raise NewtonError(
                     f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "

@@ -178,7 +178,7 @@ class LinearSolver:
         if 0 < len(left) <= WOODBURY_MAX:
             unit = np.zeros((len(old), len(left)))
             unit[left, np.arange(len(left))] = 1.0
-            columns = self._factor.solve(unit)  # A_old^-1 at the unknowns that left
+            columns = solve(unit)  # A_old^-1 at the unknowns that left
             block = scipy.linalg.cho_factor(columns[left])
 
             def correct(y: np.ndarray) -> np.ndarray:

@@ -3,16 +3,18 @@
 
 CHOLMOD as cvxopt bundles it orders by AMD, a local (minimum-degree) heuristic; on the implicit
 step's 3D matrices, whose rows couple every node within two cells (375 entries a row), nested
-dissection leaves far less fill: the graph is cut by small separators recursively, each
+dissection leaves less fill: the graph is cut by small separators recursively, each
 separator eliminated last (George 1973; METIS's multilevel version, Karypis and Kumar 1998).
-The order is computed on the graph of the nodes, not of their velocity components (27x fewer
-edges in 3D; the components of one node are ordered together), by METIS through pymetis.
+The order is computed on the graph of the nodes, not of their velocity components (in 3D 3x
+fewer vertices and 9x fewer edges; the components of one node are ordered together), by METIS
+through pymetis.
 """
 
 import numpy as np
-import scipy.sparse as sp  # noqa: F401 -- the matrices it orders
+import scipy.sparse as sp
 
-# below this many nodes AMD is as good and METIS's call costs more than it saves
+# below this many nodes AMD's order is kept (a choice: on such small systems the fill, and
+# what an order can save, is small)
 NESTED_MIN_NODES = 200
 
 
