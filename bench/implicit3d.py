@@ -4,7 +4,8 @@
 Two molten PA12 spheres, R = 20 um, touching at a point in a 120 x 60 x 60 um box (surface
 tension on, no gravity), implicit steps at the "auto" step (``--dt``: a fixed one; 1e-2 is a
 layer's hold, where the viscous stiffness outweighs the inertia 1e8 times), at h = 4, 3 and
-2.5 um (``--quick``: 4 only), each with the direct solver (CHOLMOD), AMG-CG (pyamg's smoothed
+2.5 um (``--quick``: 4 only), each with the direct solver (``direct``: its default library,
+MKL PARDISO where installed; ``direct-cholmod``: CHOLMOD), AMG-CG (pyamg's smoothed
 aggregation with the rigid-body modes) and the matrix-free step (CG with the grid multigrid,
 solver/multigrid.py), the direct one also with the rows stored by blocks
 (``time.implicit_rows = "blocks"``) beside dense ones. The process material
@@ -36,6 +37,7 @@ SPACINGS_UM = (4.0, 3.0, 2.5)
 COLUMNS = [
     "h_um",
     "solver",
+    "direct_solver",
     "rows",
     "points",
     "unknowns",
@@ -50,12 +52,20 @@ COLUMNS = [
     "bytes_per_point",
     "host_bytes_per_point",
 ]
-SOLVERS = ("direct", "direct-blocks", "amg", "matrix_free")
+SOLVERS = ("direct", "direct-cholmod", "direct-blocks", "amg", "matrix_free")
+LIBRARIES = ("cholmod", "pardiso")  # a direct solver's suffix naming its library
 
 
-def pair_case(h_um: float, solver: str, rows: str = "dense", dt_s: float | None = None) -> dict:
-    """The sphere pair at spacing h_um with time.linear_solver = solver and time.implicit_rows
-    = rows; ``dt_s``: a fixed step, with the process material."""
+def pair_case(
+    h_um: float,
+    solver: str,
+    rows: str = "dense",
+    dt_s: float | None = None,
+    library: str = "auto",
+) -> dict:
+    """The sphere pair at spacing h_um with time.linear_solver = solver, time.implicit_rows
+    = rows and time.direct_solver = library; ``dt_s``: a fixed step, with the process
+    material."""
     spheres = [
         {"center_um": [x, 30.0, 30.0], "radius_um": 20.0, "temperature_C": 200.0}
         for x in (40.0, 80.0)
@@ -65,14 +75,20 @@ def pair_case(h_um: float, solver: str, rows: str = "dense", dt_s: float | None 
         "domain": {"dim": 3, "width_um": 120.0, "height_um": 60.0, "depth_um": 60.0},
         "bodies": spheres,
         "physics": {"thermal": False, "gravity_m_s2": [0.0, 0.0, 0.0]},
-        "time": _time(solver, rows),
+        "time": _time(solver, rows, library) | ({} if dt_s is None else {"dt_s": dt_s}),
         "output": {"frames": 1},
         **({"materials": {"PA12": {"preset": "pa12_process"}}} if dt_s else {}),
-    } | ({} if dt_s is None else {"time": {**_time(solver, rows), "dt_s": dt_s}})
+    }
 
 
-def _time(solver: str, rows: str) -> dict:
-    return {"integrator": "implicit", "linear_solver": solver, "implicit_rows": rows, "end_s": 1.0}
+def _time(solver: str, rows: str, library: str) -> dict:
+    return {
+        "integrator": "implicit",
+        "linear_solver": solver,
+        "implicit_rows": rows,
+        "direct_solver": library,
+        "end_s": 1.0,
+    }
 
 
 def _grid_bytes(sim: Simulation) -> int:
@@ -91,9 +107,14 @@ def _grid_nodes(sim: Simulation) -> int:
 
 
 def measure(
-    h_um: float, solver: str, steps: int, rows: str = "dense", dt_s: float | None = None
+    h_um: float,
+    solver: str,
+    steps: int,
+    rows: str = "dense",
+    dt_s: float | None = None,
+    library: str = "auto",
 ) -> dict:
-    sim = Simulation(case_from_dict(pair_case(h_um, solver, rows, dt_s)))
+    sim = Simulation(case_from_dict(pair_case(h_um, solver, rows, dt_s, library)))
     sim.advance_to(sim.dt)  # one step: compiles the step's kernels
     spent = {"s": 0.0, "n": 0}
     kinds = (linear_solve.LinearSolver, MatrixFreeSolver)
@@ -101,10 +122,10 @@ def measure(
     host = {"bytes": 0}
 
     def timed(solve):
-        def run(self, A, b, refresh=False):
+        def run(self, A, b, *args, **kwargs):
             t0 = time.perf_counter()
             try:
-                return solve(self, A, b, refresh)
+                return solve(self, A, b, *args, **kwargs)
             finally:
                 spent["s"] += time.perf_counter() - t0
                 spent["n"] += 1
@@ -132,6 +153,9 @@ def measure(
         "h_um": h_um,
         "rows": rows,
         "solver": sim.implicit.last.solver,
+        "direct_solver": sim.implicit.linear.backend
+        if sim.implicit.last.solver == "direct"
+        else "",
         "points": sim.scene.n_points,
         "unknowns": unknowns,
         "steps": steps,
@@ -176,11 +200,13 @@ def main(args: argparse.Namespace) -> int:
     spacings = args.spacings or (SPACINGS_UM[:1] if args.quick else SPACINGS_UM)
     for h in spacings:
         for name in args.solvers:
-            solver, _, storage = name.partition("-")
-            rows.append(measure(h, solver, args.steps, storage or "dense", args.dt))
+            solver, _, suffix = name.partition("-")
+            library = suffix if suffix in LIBRARIES else "auto"
+            storage = "dense" if suffix in ("", *LIBRARIES) else suffix
+            rows.append(measure(h, solver, args.steps, storage, args.dt, library))
             r = rows[-1]
             print(
-                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['rows']:6s} "
+                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['direct_solver']:7s} {r['rows']:6s} "
                 f"{r['unknowns']:7d} unknowns "
                 f"{r['wall_per_step_s']:7.2f} s/step {r['wall_per_solve_s']:7.3f} s/solve "
                 f"{r['newton_iterations_per_step']:5.2f} Newton/step "

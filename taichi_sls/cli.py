@@ -70,7 +70,7 @@ def writable_folder(out: Path) -> None:
 
 def run_command(args: argparse.Namespace) -> int:
     """The main job: load, check, run, print the outcome."""
-    from .jobs.case_run import print_outcome, run_case
+    from .jobs.case_run import describe_wall, print_outcome, run_case
     from .solver.time_step import resolve_dt
     from .studies.verification import setups, spec
 
@@ -124,6 +124,7 @@ def run_command(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     print_outcome(summary)
+    print(describe_wall(summary["wall_breakdown_s"]), file=sys.stderr)
     if summary["status"] == "failed":
         print(f"error: {summary['error']}", file=sys.stderr)
     return EXIT_CODES[summary["status"]]

@@ -120,3 +120,18 @@ def run_command(module: list[str], case_path, out) -> subprocess.CompletedProces
         env={**os.environ, "PYTHONPATH": str(root)},
         timeout=120,
     )
+
+
+def grid_rows(nodes_per_axis: int):
+    """An SPD matrix with the implicit step's 3D pattern: 3 components a node, each node
+    coupled to the 5 x 5 x 5 nodes around it (random entries, diagonally dominant)."""
+    import numpy as np
+    import scipy.sparse as sp
+
+    band = sp.diags([1.0] * 5, [-2, -1, 0, 1, 2], shape=(nodes_per_axis,) * 2)
+    node = sp.kron(sp.kron(band, band), band)
+    A = sp.kron(node, np.ones((3, 3))).tocsr()
+    A.data = np.random.default_rng(0).random(A.nnz)
+    A = (A + A.T + 500.0 * sp.eye(A.shape[0])).tocsr()  # diagonally dominant: SPD
+    A.sort_indices()
+    return A

@@ -149,8 +149,8 @@ class Time(Model):
     )
     linear_solver: Literal["auto", "direct", "amg", "matrix_free"] = Field(
         "auto",
-        description="implicit: direct (CHOLMOD's Cholesky through cvxopt; qdldl's LDL^T where "
-        "a matrix is not positive definite), amg (conjugate gradients "
+        description="implicit: direct (a sparse Cholesky by direct_solver's library; qdldl's "
+        "LDL^T where a matrix is not positive definite), amg (conjugate gradients "
         "preconditioned by pyamg's smoothed aggregation), matrix_free (conjugate gradients "
         "on the points' tangent applied through the points, no assembled tangent, "
         "preconditioned by a geometric multigrid on the MPM grid: solver/multigrid.py) or "
@@ -167,9 +167,18 @@ class Time(Model):
     )
     direct_ordering: Literal["auto", "amd", "nested_dissection"] = Field(
         "auto",
-        description="implicit, the direct solver's elimination order: amd (CHOLMOD's own), "
-        "nested_dissection (METIS's, through pymetis, on the graph of the grid nodes: less "
-        "fill on 3D rows; solver/ordering.py) or auto (nested_dissection in 3D, amd in 2D)",
+        description="implicit, the direct solver's elimination order: amd (CHOLMOD's own; "
+        "PARDISO's minimum degree), nested_dissection (METIS's: for CHOLMOD through pymetis on "
+        "the graph of the grid nodes, solver/ordering.py; PARDISO's own: less fill on 3D "
+        "rows) or auto (nested_dissection in 3D, amd in 2D)",
+    )
+    direct_solver: Literal["auto", "cholmod", "pardiso"] = Field(
+        "auto",
+        description='implicit, linear_solver = "direct": the Cholesky factorization\'s library: '
+        "cholmod (CHOLMOD through cvxopt, on a serial BLAS), pardiso (MKL PARDISO on MKL's "
+        "threaded BLAS; needs the mkl package, x86_64: a 3D bed's Newton matrix factorized "
+        "5x faster on 2 cores, docs/record/implicit.md) or auto (pardiso in 3D where MKL is "
+        "installed, else cholmod)",
     )
     direct_max_unknowns: int | None = Field(
         None,

@@ -72,6 +72,7 @@ def run_case(
     every frame after the run's own."""
     out_dir, wall0, clock0 = Path(out_dir), time.perf_counter(), compile_clock.reading()
     baseline_um = unheated_baseline(case) if resume is None and scene is None else None
+    baseline_wall = time.perf_counter() - wall0
     sim = Simulation(case, scene=scene, before_step=before_step)
     writer = output_writer(case, out_dir)
     times = frame_times(case, sim.dt)
@@ -81,14 +82,16 @@ def run_case(
     obs = case_observers(case, sim, writer, baseline_um, warnings)
     obs += [record, rule, ProgressBar(case, horizon, progress), *observers]
     obs.append(Checkpoints(out_dir / CHECKPOINT, checkpoint_every, obs))
-    status, pacer = "failed", Pacer(sim, StopRequests())
+    status, pacer, lead_s = "failed", Pacer(sim, StopRequests()), 0.0
     with StopRequests() as stops:
         try:
+            lead0 = time.perf_counter()
             first = (
                 resume_run(sim, resume, obs)
                 if resume
                 else settle_run(case, sim, obs, record, progress, stops)
             )
+            lead_s = time.perf_counter() - lead0
             pacer = Pacer(sim, stops, [o.tick for o in obs if isinstance(o, ProgressBar)])
             for o in obs:
                 o.start(sim)
@@ -102,10 +105,13 @@ def run_case(
             status = "interrupted"
         finally:
             stops.hold()  # a further signal only marks it: the outputs are being closed
-            finish(obs, RunEnd(status, sim, summary, warnings, stops))
+            finished = finish(obs, RunEnd(status, sim, summary, warnings, stops))
             summary.update(status=status, wall_s=time.perf_counter() - wall0)
             summary.update(step_wall_s=pacer.step_wall, steps_per_s=pacer.steps_per_s)
             summary.update(warnings=list(dict.fromkeys(warnings)), **_compiled(clock0))
+            summary["wall_breakdown_s"] = wall_breakdown(
+                summary, baseline_wall, lead_s, pacer, finished
+            )
             writer.summary(summary)
     return summary
 
@@ -212,13 +218,60 @@ def resume_run(sim: Simulation, path: Path, observers: Sequence[Observer]) -> in
     return index + 1
 
 
-def finish(observers: Sequence[Observer], end: RunEnd) -> None:
-    """Each observer's end, in order; one that fails costs only its own outputs."""
+def finish(observers: Sequence[Observer], end: RunEnd) -> dict[str, float]:
+    """Each observer's end, in order; one that fails costs only its own outputs. Returns the
+    wall time (s) each took, by class name."""
+    spent: dict[str, float] = {}
     for o in observers:
+        w0 = time.perf_counter()
         try:
             o.finish(end)
         except Exception as e:  # noqa: BLE001 -- the summary is still written
             end.warnings.append(f"{type(o).__name__} not finished ({type(e).__name__}: {e})")
+        name = type(o).__name__
+        spent[name] = spent.get(name, 0.0) + time.perf_counter() - w0
+    return spent
+
+
+def wall_breakdown(
+    summary: dict[str, Any],
+    baseline_s: float,
+    settle_s: float,
+    pacer: Pacer,
+    finished: dict[str, float],
+) -> dict[str, Any]:
+    """Where the run's wall time went (s): the unheated baseline, settling (a resumed run:
+    reading its checkpoint), stepping, the observers' work on the frames and at the end (each
+    by name, and their sums), and the rest (building the scene, compiling outside the steps,
+    the first outputs). ``compile_s`` is part of the others (a kernel compiles when it first
+    runs), shown for comparison."""
+    frames_s, end_s = sum(pacer.observer_wall.values()), sum(finished.values())
+    parts = baseline_s + settle_s + pacer.step_wall + frames_s + end_s
+    return {
+        "baseline_s": baseline_s,
+        "settle_s": settle_s,
+        "stepping_s": pacer.step_wall,
+        "frames_s": frames_s,
+        "end_s": end_s,
+        "other_s": summary["wall_s"] - parts,
+        "compile_s": summary["compile_s"],
+        "frames_by_observer_s": dict(pacer.observer_wall),
+        "end_by_observer_s": finished,
+    }
+
+
+def describe_wall(b: dict[str, Any]) -> str:
+    """One line: the wall time by part, with the share outside the solver's steps."""
+    total = b["baseline_s"] + b["settle_s"] + b["stepping_s"] + b["frames_s"]
+    total += b["end_s"] + b["other_s"]
+    outside = b["frames_s"] + b["end_s"] + b["other_s"]
+    share = outside / total if total > 0 else 0.0
+    return (
+        f"wall time {total:.1f} s: stepping {b['stepping_s']:.1f}, settling {b['settle_s']:.1f}, "
+        f"baseline {b['baseline_s']:.1f}, frames {b['frames_s']:.1f}, outputs at the end "
+        f"{b['end_s']:.1f}, set-up and the rest {b['other_s']:.1f} ({share:.0%} outside the "
+        f"steps); compiling {b['compile_s']:.1f} of it"
+    )
 
 
 def record_failure(

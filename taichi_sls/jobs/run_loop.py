@@ -143,6 +143,7 @@ class Pacer:
         self.sim, self.stops, self.ticks = sim, stops, ticks
         self.steps0 = sim.steps
         self.step_wall = 0.0
+        self.observer_wall: dict[str, float] = {}  # each observer's frames, by class name
         self.index = 0  # the frame being stepped to (a failed run's last frame takes it)
         self.chunk = FIRST_CHUNK
 
@@ -184,7 +185,11 @@ def run_frames(
         pacer.advance_to(t)
         frame = Frame(index, pacer.sim, named_monitors(pacer.sim))
         for o in observers:
+            w0 = time.perf_counter()
             o.frame(frame)
+            name = type(o).__name__
+            spent = time.perf_counter() - w0
+            pacer.observer_wall[name] = pacer.observer_wall.get(name, 0.0) + spent
         if any(getattr(o, "stop", False) for o in observers):
             return True
     return False

@@ -353,7 +353,7 @@ class ImplicitStepper:
         if how == "matrix_free":
             self.linear = MatrixFreeSolver.for_step(self.linear, st, sys_)
         elif self.linear is None or self.linear.how != how:
-            self.linear = LinearSolver(how, LINEAR_RTOL)
+            self.linear = LinearSolver.for_case(self.case, how, LINEAR_RTOL)
         if how == "amg":  # smoothed aggregation for elasticity (solver/linear_solve.py)
             self.linear.near_null = sys_.rigid_body_modes()
         if how == "direct" and nested_ordering(self.case):

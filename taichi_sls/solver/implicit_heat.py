@@ -207,7 +207,7 @@ class StepHeat:
             A.has_sorted_indices = True
             how = linear_solver(self.case, n, assembled=True)
             if self.linear is None or self.linear.how != how:
-                self.linear = LinearSolver(how, HEAT_RTOL)
+                self.linear = LinearSolver.for_case(self.case, how, HEAT_RTOL)
             keys = unknown_keys(nodes)
             if how == "direct" and nested_ordering(self.case):
                 self.linear.nodes = keys

@@ -11,9 +11,10 @@ takes a new tangent, and solves with that very matrix over its next Newton itera
 the factorization alone, no CG). CG is written out here (``preconditioned_cg``): its iterations
 are few, and scipy's wrapper adds a per-call overhead of the order of theirs.
 
-- ``direct``: CHOLMOD's supernodal Cholesky (through cvxopt; its numeric refactorization reuses
-  the symbolic one while the pattern is unchanged), or where a matrix is not positive definite
-  qdldl's LDL^T with AMD ordering: exact for the matrix it was built from.
+- ``direct``: a supernodal Cholesky (``time.direct_solver``: CHOLMOD's through cvxopt, or MKL
+  PARDISO's, solver/pardiso.py; the numeric refactorization reuses the symbolic one while the
+  pattern is unchanged), or where a matrix is not positive definite qdldl's LDL^T with AMD
+  ordering: exact for the matrix it was built from.
 - ``amg``: pyamg's smoothed-aggregation hierarchy as the preconditioner (memory and time linear
   in the unknowns, for the large systems where a factorization's fill grows too big); given
   ``near_null`` (the implicit step gives the rigid-body modes of its grid velocities, 3 in 2D
@@ -28,7 +29,10 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ..config import Case
+from ..config.errors import CaseError
+from .direct_factor import CHOLMOD, PARDISO, DirectFactor, LinearSolveError
 from .ordering import nested_dissection
+from .pardiso import available
 
 CG_MAX_ITERATIONS = 500
 # LinearSolver._mapped: the most unknowns leaving the system whose effect on the kept
@@ -36,11 +40,6 @@ CG_MAX_ITERATIONS = 500
 WOODBURY_MAX = 64
 # preconditioned_cg(predict=True): the iterations after which it judges its rate
 PREDICT_AFTER = 5
-
-
-class LinearSolveError(RuntimeError):
-    """No factorization of the matrix exists (singular or indefinite), or conjugate gradients
-    with a fresh preconditioner did not converge."""
 
 
 # time.direct_max_unknowns unset: the largest direct solve by dimension (docs/record/implicit.md)
@@ -51,6 +50,19 @@ def direct_max_unknowns(case: Case) -> int:
     """``time.direct_max_unknowns``, or where unset the dimension's DIRECT_MAX_UNKNOWNS."""
     limit = case.time.direct_max_unknowns
     return DIRECT_MAX_UNKNOWNS[case.domain.dim] if limit is None else limit
+
+
+def direct_backend(case: Case) -> str:
+    """``time.direct_solver``; "auto": PARDISO in 3D where MKL is installed, else CHOLMOD."""
+    choice = case.time.direct_solver
+    if choice == "auto":
+        return PARDISO if case.domain.dim == 3 and available() else CHOLMOD
+    if choice == PARDISO and not available():
+        raise CaseError(
+            'time.direct_solver = "pardiso": MKL is not installed here (pip install mkl, on '
+            'x86_64); allowed: "cholmod" or "auto"'
+        )
+    return choice
 
 
 def nested_ordering(case: Case) -> bool:
@@ -81,9 +93,12 @@ class SolveStats:
 
 class LinearSolver:
     """A x = b for a sequence of SPD matrices (module docstring). ``how``: "direct" or "amg";
-    ``rtol``: the relative residual of a preconditioned CG solve."""
+    ``rtol``: the relative residual of a preconditioned CG solve; ``backend``: the direct
+    factorization's library, "cholmod" or "pardiso"."""
 
-    def __init__(self, how: str, rtol: float, refresh_after: int = 20) -> None:
+    def __init__(
+        self, how: str, rtol: float, refresh_after: int = 20, backend: str = CHOLMOD
+    ) -> None:
         if how not in ("direct", "amg"):
             raise ValueError(f"linear solver {how!r}: allowed: direct, amg")
         self.how = how
@@ -103,6 +118,12 @@ class LinearSolver:
         self._keys: np.ndarray | None = None  # the factorized matrix's unknowns (ascending)
         self._map: tuple | None = None  # (keys, preconditioner) of _mapped's last call
         self._kept_failed = False  # the kept factorization failed the last matrix it met
+        self.backend = backend  # direct: the factorization's library (time.direct_solver)
+
+    @classmethod
+    def for_case(cls, case: Case, how: str, rtol: float) -> "LinearSolver":
+        """The solver of a case's systems: its direct factorizations by ``time.direct_solver``."""
+        return cls(how, rtol, backend=direct_backend(case))
 
     def solve(
         self,
@@ -211,8 +232,11 @@ class LinearSolver:
         if self.how == "direct":
             try:
                 if new_pattern or self._factor is None:
-                    order = None if self.nodes is None else nested_dissection(A, self.nodes)
-                    self._factor = DirectFactor(A, order)
+                    # PARDISO orders by its own METIS, CHOLMOD by solver/ordering.py's
+                    ordered = self.nodes is not None and self.backend == CHOLMOD
+                    order = nested_dissection(A, self.nodes) if ordered else None
+                    nested = self.nodes is not None
+                    self._factor = DirectFactor(A, order, self.backend, nested)
                 else:
                     self._factor.update(A)
             except LinearSolveError:  # nothing kept: the next matrix starts afresh
@@ -241,76 +265,6 @@ class LinearSolver:
         x, iterations, converged = preconditioned_cg(A, b, precondition, self.rtol, limit, predict)
         self.stats.cg_iterations += iterations
         return x, converged
-
-
-class DirectFactor:
-    """A factorization of a symmetric matrix A (CSR, both triangles stored) that a matrix of the
-    same pattern can refresh: CHOLMOD's supernodal Cholesky of A's lower triangle, faster than
-    qdldl's simplicial LDL^T on the implicit step's matrices (docs/record/implicit.md); qdldl
-    where Cholesky finds A not positive definite."""
-
-    def __init__(self, A: sp.csr_matrix, order: np.ndarray | None = None) -> None:
-        """``order``: the elimination order (solver/ordering.py); None: CHOLMOD's AMD."""
-        from cvxopt import matrix, spmatrix
-
-        self._p = None if order is None else matrix(order.astype(np.int32).tolist())
-
-        n = A.shape[0]
-        rows = np.repeat(np.arange(n), np.diff(A.indptr))
-        lower = np.flatnonzero(rows >= A.indices)
-        # CHOLMOD keeps the entries in column order: build the matrix once with each entry's
-        # index in A.data as its value, and read back where each of A's entries goes
-        self._lower = spmatrix(
-            matrix(lower.astype(float)),
-            matrix(rows[lower].astype(np.int64)),
-            matrix(A.indices[lower].astype(np.int64)),
-            (n, n),
-        )
-        self._order = np.asarray(self._lower.V).ravel().astype(np.int64)
-        self._symbolic = None
-        self.update(A)
-
-    def update(self, A: sp.csr_matrix) -> None:
-        """Factorize A, whose pattern is the one this factor was built with."""
-        from cvxopt import cholmod, matrix
-
-        self._lower.V = matrix(A.data[self._order])
-        self._ldl = None
-        try:
-            if self._symbolic is None:
-                if self._p is None:
-                    self._symbolic = cholmod.symbolic(self._lower)
-                else:
-                    self._symbolic = cholmod.symbolic(self._lower, p=self._p)
-            cholmod.numeric(self._lower, self._symbolic)
-        except ArithmeticError:  # not positive definite: LDL^T, and a fresh analysis next time
-            import qdldl
-
-            self._symbolic = None
-            try:
-                self._ldl = qdldl.Solver(A.tocsc())  # symmetric: its CSC is its CSR transposed
-            except RuntimeError as e:  # a zero pivot: singular, or not quasi-definite
-                raise LinearSolveError(
-                    f"neither Cholesky nor LDL^T factorizes the {A.shape[0]} x {A.shape[0]} "
-                    f"matrix ({e})"
-                ) from e
-
-    @property
-    def cholesky(self) -> bool:
-        """Whether the last update found the matrix positive definite (CHOLMOD holds it)."""
-        return self._ldl is None
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """A^-1 b, b a vector or a matrix of columns."""
-        if self._ldl is not None:
-            if b.ndim == 2:
-                return np.column_stack([self._ldl.solve(c) for c in b.T])
-            return self._ldl.solve(b)
-        from cvxopt import cholmod, matrix
-
-        x = matrix(np.ascontiguousarray(b))
-        cholmod.solve(self._symbolic, x)
-        return np.asarray(x).reshape(b.shape)
 
 
 def preconditioned_cg(

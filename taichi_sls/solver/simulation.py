@@ -22,6 +22,7 @@ from .fields import State
 from .guard import Guard, temperature_floor_K
 from .handover import Handover, HybridStepper, explicit_view
 from .implicit import ImplicitStepper
+from .linear_solve import direct_backend
 from .monitor import point_monitors
 from .necks import HOST_POINT_MEMBERS, Necks, point_arrays
 from .params import imposed_table, laser_arrays, material_arrays
@@ -95,6 +96,7 @@ class Simulation:
         self.case = case
         self.before_step = before_step
         self.dt, self.dt_limits = resolve_dt(case)
+        direct_backend(case)  # refuses a direct solver that cannot run here, before compiling
         self.heat_every = resolve_heat_every(case, self.dt, self.dt_limits)
         self.curvature_every = resolve_curvature_every(case, self.dt, self.dt_limits)
         self.scene: Scene = build_scene(case) if scene is None else scene

@@ -48,6 +48,14 @@ def test_main_job_writes_every_output(tmp_path):
     for key in ("case", "steps", "simulated_s", "wall_s", "compile_s", "steps_per_s", "points"):
         assert key in s
     assert s["nodes"] == 322 and s["points"] == 632
+    # where the wall time went (issue #53): every part measured, none counted twice (the rest,
+    # the wall time less the parts, is not negative), the frames by observer
+    wall = s["wall_breakdown_s"]
+    assert wall["stepping_s"] == s["step_wall_s"] and wall["settle_s"] < 1e-2  # no settling
+    assert all(wall[k] >= 0.0 for k in ("baseline_s", "frames_s", "end_s", "other_s"))
+    assert {"Frames", "TimeSeries", "PairVerdict"} <= set(wall["frames_by_observer_s"])
+    assert sum(wall["frames_by_observer_s"].values()) == pytest.approx(wall["frames_s"])
+    assert wall["end_by_observer_s"]["Frames"] > 0.0  # the GIF and the plots
     assert s["final"]["T_max_C"] > s["initial"]["T_max_C"]
     assert abs(s["simulated_s"] - 2e-5) < 1e-6
     mesh = meshio.read(sorted((out / "vtu").glob("*.vtu"))[-1])

@@ -54,8 +54,10 @@ RUNS: dict[str, tuple[str, list[str], bool]] = {
 BED_OUTCOME_KEPT = ("fused", "no_verdict")
 # Intended change of issue #53: a run with implicit steps records its linear solves in the
 # summary (``linear_solves``), a block the records before it lack; checked here for its keys
+# (``direct_solver``: the factorization's library, time.direct_solver, added with it)
 LINEAR_SOLVES_KEYS = {
     "solver",
+    "direct_solver",
     "newton_iterations",
     "solves",
     "factorizations",

@@ -42,6 +42,7 @@ TIMINGS = (
     "kernels_compiled",
     "wall_s",
     "step_wall_s",
+    "wall_breakdown_s",
     "steps_per_s",
 )
 

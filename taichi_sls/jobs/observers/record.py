@@ -19,12 +19,16 @@ def _counts(sim: Simulation) -> dict[str, int]:
 
 def linear_solves(sim: Simulation) -> dict[str, Any]:
     """The implicit steps' solves since the run (or its resume) started: the linear solver of
-    the last step (time.linear_solver), Newton iterations, linear solves, factorizations (or
+    the last step (time.linear_solver) and its direct factorization's library
+    (time.direct_solver, where it factorizes), Newton iterations, linear solves, factorizations (or
     multigrid set-ups), conjugate-gradient iterations and the last step's relative residual."""
     imp = sim.implicit
     stats = getattr(imp.linear, "stats", None)
     return {
         "solver": imp.last.solver or None,
+        "direct_solver": getattr(imp.linear, "backend", None)
+        if imp.last.solver == "direct"
+        else None,
         "newton_iterations": int(imp.newton_total),
         "solves": stats.solves if stats is not None else 0,
         "factorizations": stats.factorizations if stats is not None else 0,
