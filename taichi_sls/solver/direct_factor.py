@@ -12,7 +12,6 @@ import scipy.sparse as sp
 from .pardiso import NOT_POSITIVE_DEFINITE, PardisoError, PardisoFactor
 
 CHOLMOD, PARDISO = "cholmod", "pardiso"  # time.direct_solver's libraries
-ORDERING = {True: "nested_dissection", False: "amd"}  # PARDISO's, by nested_ordering
 
 
 class LinearSolveError(RuntimeError):
@@ -96,7 +95,7 @@ class DirectFactor:
     def _factorize_pardiso(self, A: sp.csr_matrix) -> None:
         try:
             if self._pardiso is None:
-                self._pardiso = PardisoFactor(A, ORDERING[self._nested])
+                self._pardiso = PardisoFactor(A, "nested_dissection" if self._nested else "amd")
             else:
                 self._pardiso.update(A)
         except PardisoError as e:

@@ -89,29 +89,25 @@ class PardisoFactor:
         self._handle = np.zeros(64, dtype=np.int64)  # PARDISO's own pointers: never moved
         self._iparm = np.zeros(64, dtype=np.int32)
         # PARDISO's memory goes with this object (or at exit, while the modules still exist)
-        weakref.finalize(self, _release, self._pardiso, self._handle, self._iparm)
+        weakref.finalize(self, _invoke, self._pardiso, self._handle, self._iparm, RELEASE)
         self._iparm[0] = 1  # these settings, not the defaults
         self._iparm[1] = ORDERINGS[ordering]
         self._iparm[34] = 1  # zero-based indices
-        self._n = A.shape[0]
         upper = sp.triu(A, format="csr")
         upper.sort_indices()
         self._indptr = upper.indptr.astype(np.int32)
         self._indices = upper.indices.astype(np.int32)
         # where each of the upper triangle's entries lies in A.data, for a refresh
-        rows = np.repeat(np.arange(self._n), np.diff(A.indptr))
+        rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
         self._take = np.flatnonzero(A.indices >= rows)
-        self._values = np.ascontiguousarray(A.data[self._take])
+        self._values = np.ascontiguousarray(upper.data)
         self._call(ANALYSIS)
-        self._factored = False
-        self.update(A)
+        self._call(FACTORIZATION)
 
     def update(self, A: sp.csr_matrix) -> None:
         """Factorize A, whose pattern is the one this factor was built with."""
         self._values = np.ascontiguousarray(A.data[self._take])
-        self._factored = False
         self._call(FACTORIZATION)
-        self._factored = True
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """A^-1 b, b a vector or a matrix of columns."""
@@ -123,53 +119,48 @@ class PardisoFactor:
     def _call(
         self, phase: int, b: np.ndarray | None = None, x: np.ndarray | None = None, nrhs: int = 1
     ) -> None:
-        error = ctypes.c_int32(0)
-
-        def int32(v: int) -> ctypes.c_int32:
-            return ctypes.byref(ctypes.c_int32(v))
-
-        self._pardiso(
-            self._handle.ctypes.data,
-            int32(1),  # maxfct
-            int32(1),  # mnum
-            int32(SPD),
-            int32(phase),
-            int32(self._n),
-            self._values.ctypes.data,
-            self._indptr.ctypes.data,
-            self._indices.ctypes.data,
-            None,  # perm
-            int32(nrhs),
-            self._iparm.ctypes.data,
-            int32(0),  # msglvl
-            None if b is None else b.ctypes.data,
-            None if x is None else x.ctypes.data,
-            ctypes.byref(error),
-        )
-        if error.value != 0:
-            raise PardisoError(error.value, phase)
+        matrix = (self._values, self._indptr, self._indices)
+        error = _invoke(self._pardiso, self._handle, self._iparm, phase, matrix, b, x, nrhs)
+        if error != 0:
+            raise PardisoError(error, phase)
 
 
-def _release(pardiso: ctypes._CFuncPtr, handle: np.ndarray, iparm: np.ndarray) -> None:
-    """PARDISO's phase -1: all memory of the factorization behind ``handle``."""
-    one, error = ctypes.c_int32(1), ctypes.c_int32(0)
-    n, phase, mtype = ctypes.c_int32(0), ctypes.c_int32(RELEASE), ctypes.c_int32(SPD)
-    by = ctypes.byref
+def _invoke(
+    pardiso: ctypes._CFuncPtr,
+    handle: np.ndarray,
+    iparm: np.ndarray,
+    phase: int,
+    matrix: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    b: np.ndarray | None = None,
+    x: np.ndarray | None = None,
+    nrhs: int = 1,
+) -> int:
+    """One call of ``pardiso`` on the factorization behind ``handle``: ``matrix`` the upper
+    triangle's (values, indptr, indices) in CSR, None for the release. Returns PARDISO's error
+    code (0: none)."""
+    error = ctypes.c_int32(0)
+
+    def int32(v: int) -> ctypes.c_int32:
+        return ctypes.byref(ctypes.c_int32(v))
+
+    values, indptr, indices = (None, None, None) if matrix is None else matrix
+    n = 0 if indptr is None else len(indptr) - 1
     pardiso(
         handle.ctypes.data,
-        by(one),
-        by(one),
-        by(mtype),
-        by(phase),
-        by(n),
-        None,
-        None,
-        None,
-        None,
-        by(one),
+        int32(1),  # maxfct
+        int32(1),  # mnum
+        int32(SPD),
+        int32(phase),
+        int32(n),
+        None if values is None else values.ctypes.data,
+        None if indptr is None else indptr.ctypes.data,
+        None if indices is None else indices.ctypes.data,
+        None,  # perm
+        int32(nrhs),
         iparm.ctypes.data,
-        by(ctypes.c_int32(0)),
-        None,
-        None,
-        by(error),
+        int32(0),  # msglvl
+        None if b is None else b.ctypes.data,
+        None if x is None else x.ctypes.data,
+        ctypes.byref(error),
     )
+    return error.value
