@@ -9,6 +9,7 @@ the matrix it was built from; solver/linear_solve.py keeps one across solves.
 import numpy as np
 import scipy.sparse as sp
 
+from .ordering import nested_dissection
 from .pardiso import NOT_POSITIVE_DEFINITE, PardisoError, PardisoFactor
 
 CHOLMOD, PARDISO = "cholmod", "pardiso"  # time.direct_solver's libraries
@@ -27,16 +28,12 @@ class DirectFactor:
     A not positive definite."""
 
     def __init__(
-        self,
-        A: sp.csr_matrix,
-        order: np.ndarray | None = None,
-        backend: str = CHOLMOD,
-        nested: bool = True,
+        self, A: sp.csr_matrix, nodes: np.ndarray | None = None, backend: str = CHOLMOD
     ) -> None:
-        """``order``: CHOLMOD's elimination order (solver/ordering.py); None: its AMD.
-        ``backend``: "cholmod" or "pardiso", which orders by METIS's nested dissection
-        (``nested``) or its minimum degree."""
-        self.backend, self._nested = backend, nested
+        """``nodes``: each unknown's grid node, where the elimination orders by nested
+        dissection (CHOLMOD: of the nodes' graph, solver/ordering.py; PARDISO: its own METIS);
+        None: CHOLMOD's AMD, PARDISO's minimum degree. ``backend``: "cholmod" or "pardiso"."""
+        self.backend, self._nested = backend, nodes is not None
         self._pardiso: PardisoFactor | None = None
         self._symbolic = None
         if backend == PARDISO:
@@ -44,6 +41,7 @@ class DirectFactor:
             return
         from cvxopt import matrix, spmatrix
 
+        order = None if nodes is None else nested_dissection(A, nodes)
         self._p = None if order is None else matrix(order.astype(np.int32).tolist())
 
         n = A.shape[0]

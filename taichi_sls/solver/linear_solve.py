@@ -31,7 +31,6 @@ import scipy.sparse as sp
 from ..config import Case
 from ..config.errors import CaseError
 from .direct_factor import CHOLMOD, PARDISO, DirectFactor, LinearSolveError
-from .ordering import nested_dissection
 from .pardiso import available
 
 CG_MAX_ITERATIONS = 500
@@ -113,7 +112,7 @@ class LinearSolver:
         # on its coarse levels; None: the constant vector (pyamg's default)
         self.near_null: np.ndarray | None = None
         # direct: each unknown's node (a label), where the factorization is ordered by nested
-        # dissection of the nodes' graph (time.direct_ordering); None: CHOLMOD's AMD
+        # dissection (time.direct_ordering; DirectFactor); None: AMD or minimum degree
         self.nodes: np.ndarray | None = None
         self._keys: np.ndarray | None = None  # the factorized matrix's unknowns (ascending)
         self._map: tuple | None = None  # (keys, preconditioner) of _mapped's last call
@@ -232,11 +231,7 @@ class LinearSolver:
         if self.how == "direct":
             try:
                 if new_pattern or self._factor is None:
-                    # PARDISO orders by its own METIS, CHOLMOD by solver/ordering.py's
-                    ordered = self.nodes is not None and self.backend == CHOLMOD
-                    order = nested_dissection(A, self.nodes) if ordered else None
-                    nested = self.nodes is not None
-                    self._factor = DirectFactor(A, order, self.backend, nested)
+                    self._factor = DirectFactor(A, self.nodes, self.backend)
                 else:
                     self._factor.update(A)
             except LinearSolveError:  # nothing kept: the next matrix starts afresh

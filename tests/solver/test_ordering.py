@@ -25,7 +25,7 @@ def test_nested_dissection_orders_nodes_and_cuts_fill():
     assert np.array_equal(np.sort(order), np.arange(A.shape[0]))
     assert np.all(nodes[order].reshape(-1, 3) == nodes[order][::3, None])
     b = np.random.default_rng(1).random(A.shape[0])
-    nested, amd = DirectFactor(A, order), DirectFactor(A)
+    nested, amd = DirectFactor(A, nodes), DirectFactor(A)
     for factor in (nested, amd):
         assert np.linalg.norm(A @ factor.solve(b) - b) <= 1e-12 * np.linalg.norm(b)
     assert _factor_entries(nested) < 0.95 * _factor_entries(amd)

@@ -26,9 +26,7 @@ def linear_solves(sim: Simulation) -> dict[str, Any]:
     stats = getattr(imp.linear, "stats", None)
     return {
         "solver": imp.last.solver or None,
-        "direct_solver": getattr(imp.linear, "backend", None)
-        if imp.last.solver == "direct"
-        else None,
+        "direct_solver": imp.linear.backend if imp.last.solver == "direct" else None,
         "newton_iterations": int(imp.newton_total),
         "solves": stats.solves if stats is not None else 0,
         "factorizations": stats.factorizations if stats is not None else 0,
