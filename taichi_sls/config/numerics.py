@@ -180,6 +180,15 @@ class Time(Model):
         "5x faster on 2 cores, docs/record/implicit.md) or auto (pardiso in 3D where MKL is "
         "installed, else cholmod)",
     )
+    direct_pattern: Literal["auto", "step", "envelope"] = Field(
+        "auto",
+        description='implicit, linear_solver = "direct", the mechanics: step (each step '
+        "factorizes over its own unknowns: a new analysis whenever a node crosses the mass "
+        "cut) or envelope (over an envelope of nodes kept across steps, those of a tenth of "
+        "the cut and above, the others' rows the identity: the same solution, an analysis only "
+        "when the step's unknowns leave it; solver/envelope.py) or auto (envelope in 3D, step "
+        "in 2D)",
+    )
     direct_max_unknowns: int | None = Field(
         None,
         ge=1,

@@ -4,9 +4,10 @@
    laser's track if it scans along x, else the mid-depth, across the tracks of a scan along z;
    y up as in the 2D frames), the melt outlined (liquid fraction 1/2, cyan);
 2. the liquid fraction on the same section;
-3. the material's surface (colour c = 1/2, io/surface3d.py) in perspective, coloured by the
-   temperature and lit by one distant light (Lambert: the colour times 0.3 + 0.7 cos of the
-   angle between the surface's normal and the light).
+3. the material's surface (colour c = 1/2, io/surface3d.py) in an orthographic view over the
+   box's edges (io/surface_image.py), coloured by the temperature and lit by one distant light
+   (Lambert: the colour times 0.3 + 0.7 cos of the angle between the surface's normal and the
+   light), with a scale bar.
 
 The section and the surface are read off one colour grid of the point spacing
 (io/surface3d.colour_grid), so the section's material and the surface agree. One figure is
@@ -28,7 +29,6 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.ndimage import zoom
 
 from .frame_panels import (
@@ -43,11 +43,14 @@ from .frame_panels import (
     temperature_cmap,
 )
 from .surface3d import SURFACE_LEVEL, ColourGrid, Surface, colour_grid, surface
+from .surface_image import OrthographicView, Projection, draw_surface, fit_box
 
 # the light: from above (y), in front (-z: the viewer's side) and to the left (-x)
 LIGHT = np.array([-0.4, 1.0, -0.6]) / np.linalg.norm([-0.4, 1.0, -0.6])
 AMBIENT = 0.3  # the light a face turned away from the light still gets
-VIEW_ELEV_DEG, VIEW_AZIM_DEG = 25.0, -60.0  # the camera of the surface panel
+# the camera of the surface panel, over the plot's axes (x, z, y): the solver's y up
+VIEW = OrthographicView(elev_deg=25.0, azim_deg=-60.0)
+PLOT_AXES = [0, 2, 1]  # the solver's (x, y, z) shown as the plot's (x, z, y)
 SECTION_REFINE = 4  # section pixels per colour-grid node spacing
 PANEL_W_IN = 3.6  # inches per panel: three panels and colour bars ~ 950 px at dpi 80
 
@@ -156,7 +159,7 @@ class Frame3DPainter:
         gs = fig.add_gridspec(1, 3, width_ratios=(1.0, 1.0, 1.4))
         ax_t = fig.add_subplot(gs[0])
         ax_l = fig.add_subplot(gs[1])
-        ax_s = fig.add_subplot(gs[2], projection="3d")
+        ax_s = fig.add_subplot(gs[2])
         z = self.view.section_z_um
         self._images = []
         for ax, cmap, label, title in (
@@ -168,19 +171,18 @@ class Frame3DPainter:
             section_axes(ax, self.domain_um, title, 9)
             self._images.append(im)
         self._images[1].set_clim(0.0, 1.0)
-        # the solver's (x, y up, z) shown as the plot's (x, z, y): up is up
-        ax_s.set_xlim(xmin, xmax)
-        ax_s.set_ylim(zmin, zmax)
-        ax_s.set_zlim(ymin, ymax)
-        ax_s.set_box_aspect((xmax - xmin, zmax - zmin, ymax - ymin))
-        ax_s.view_init(elev=VIEW_ELEV_DEG, azim=VIEW_AZIM_DEG)
-        ax_s.set_xlabel("x [um]", fontsize=8)
-        ax_s.set_ylabel("z [um]", fontsize=8)
-        ax_s.set_zlabel("y [um]", fontsize=8)
-        ax_s.tick_params(labelsize=7)
+        box = np.array([(xmin, xmax), (zmin, zmax), (ymin, ymax)])  # the plot's axes
+        width_px = int(fig.get_figwidth() * ax_s.get_position().width * self.dpi)
+        self._projection = fit_box(VIEW, box, max(width_px, 16))
+        self._box_edges = box_edges(box)
+        ax_s.set_axis_off()
         ax_s.set_title("surface, lit, by temperature", fontsize=9)
+        self._surface_image = ax_s.imshow(
+            np.zeros((*self._projection.size[::-1], 4)), interpolation="nearest"
+        )
+        scale_bar(ax_s, self._projection, xmax - xmin)
         self._ax_t, self._ax_s = ax_t, ax_s
-        self._contour = self._mesh = None
+        self._contour = None
         self._fig = fig
 
     def draw(self, t_s: float, grid: ColourGrid, surf: Surface, T_points: np.ndarray) -> None:
@@ -198,21 +200,40 @@ class Frame3DPainter:
             im.set_data(np.ma.masked_where(~(material & np.isfinite(v)), v))
             im.set_extent(extent)
         self._images[0].set_clim(*clim)
-        for artist in (self._contour, self._mesh):
-            remove_artist(artist)
-        self._mesh = None
+        remove_artist(self._contour)
         self._contour = melt_outline(self._ax_t, xs, ys, material, lf)
-        if len(surf.tris):
-            colour = self.cmap(Normalize(*clim)(surf.values["T_C"][surf.tris].mean(axis=1)))
-            colour[:, :3] *= shade(surf.normals())[:, None]
-            self._mesh = Poly3DCollection(
-                surf.verts[surf.tris][:, :, [0, 2, 1]],
-                facecolors=colour,
-                linewidths=0.0,
-                antialiased=False,  # a third of the time; no seams at 51,000 triangles
-            )
-            self._ax_s.add_collection3d(self._mesh)
+        colour = self.cmap(Normalize(*clim)(surf.values["T_C"][surf.tris].mean(axis=1)))
+        normals = surf.normals()
+        colour[:, :3] *= shade(normals)[:, None]
+        image = draw_surface(
+            self._projection,
+            surf.verts[:, PLOT_AXES],
+            surf.tris,
+            normals[:, PLOT_AXES],
+            colour,
+            self._box_edges,
+        )
+        self._surface_image.set_data(image)
         self._fig.suptitle(frame_time_label(t_s))
 
     def close(self) -> None:
         self._fig = None
+
+
+def box_edges(box: np.ndarray) -> np.ndarray:
+    """The 12 edges (12, 2, 3) of the box ((lo, hi) per axis, (3, 2))."""
+    corners = np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T  # index: 4i + 2j + k
+    pairs = [(a, a | bit) for bit in (4, 2, 1) for a in range(8) if not a & bit]
+    return np.array([(corners[a], corners[b]) for a, b in pairs])
+
+
+def scale_bar(ax: Any, proj: Projection, width_um: float) -> None:
+    """A bar of a round length (1, 2 or 5 times a power of ten, about a fifth of the box's
+    width) in the image's lower left, labelled in um."""
+    target = 0.2 * width_um
+    power = 10.0 ** np.floor(np.log10(target))
+    length = max(m * power for m in (1.0, 2.0, 5.0) if m * power <= target)
+    w, h = proj.size
+    x0, y0 = 0.05 * w, 0.95 * h
+    ax.plot([x0, x0 + length * proj.scale], [y0, y0], color="black", linewidth=2)
+    ax.text(x0, y0 - 0.03 * h, f"{length:g} um", fontsize=7, va="bottom")

@@ -107,11 +107,20 @@ class ContactHistory:
         self.molten_now = np.zeros(n, dtype=bool)
         self.density_initial: dict[str, float] | None = None
         self.started = False
+        self._regions: tuple[np.ndarray, list[np.ndarray]] | None = None  # (x0, regions)
+
+    def regions(self, sim: Simulation) -> list[np.ndarray]:
+        """:func:`neck_regions` of the contacts, read again only when the points' start
+        positions in their current order change (the blocks layout sorts the points)."""
+        x0 = sim.point_arrays(("x0",))["x0"]
+        if self._regions is None or not np.array_equal(self._regions[0], x0):
+            self._regions = (x0, neck_regions(sim, self.points, self.normals))
+        return self._regions[1]
 
     def add(self, sim: Simulation) -> None:
         necks = np.array(sim.necks.pair_necks_m()) * 1e6
         liquid = 1.0 - sim.point_arrays(("solid_fraction",))["solid_fraction"]
-        regions = neck_regions(sim, self.points, self.normals)
+        regions = self.regions(sim)
         self.molten_now = np.array([bool(np.any(liquid[r] > 0.0)) for r in regions], dtype=bool)
         if not self.started:
             self.initial = necks.copy()
@@ -136,7 +145,7 @@ class ContactHistory:
         """The contacts table (contacts.csv), one row per contact, with the verdict."""
         f = sim.case.fusion
         tm = sim.point_arrays(("time_molten",))["time_molten"]
-        regions = neck_regions(sim, self.points, self.normals)
+        regions = self.regions(sim)
         heated = laser_acted(sim.case)
         out = []
         for k, ((a, b), p) in enumerate(zip(self.contacts, self.points, strict=True)):

@@ -112,17 +112,25 @@ def point_colour(
     step (3x3 uGIMP stencil, 3x3x3 in 3D, clamped as solver/step.py clamps it) for a subset of
     the points. With weight = m_p / (rho V_cell) it is the raw mass colour of those points
     alone."""
-    out = np.zeros(shape)
     f = x / h
     base = np.floor(f + 0.5).astype(int) - 1
     w = [gimp_1d((f - (base + a)) * h, h, lp) for a in range(3)]  # each (N, 2)
     idx = np.clip(base + off, 1, np.array(shape) - 4)
+    flat = np.ravel_multi_index(tuple(idx.T), shape)  # each stencil's corner node
+    stride = np.ravel_multi_index(tuple(np.eye(len(shape), dtype=int)), shape)  # per axis
+    nodes, weights = [], []
     for a in range(3):
         for b in range(3):
             wab = weight * w[a][:, 0] * w[b][:, 1]
             if len(shape) == 2:
-                np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b), wab)
+                nodes.append(flat + a * stride[0] + b * stride[1])
+                weights.append(wab)
                 continue
             for c in range(3):  # 3D: the third axis of the stencil
-                np.add.at(out, (idx[:, 0] + a, idx[:, 1] + b, idx[:, 2] + c), wab * w[c][:, 2])
-    return out
+                nodes.append(flat + a * stride[0] + b * stride[1] + c * stride[2])
+                weights.append(wab * w[c][:, 2])
+    # one scatter, each node's sum in the stencil's order and then the points' (as a loop of
+    # np.add.at over the stencil would add them)
+    size = int(np.prod(shape))
+    out = np.bincount(np.concatenate(nodes), np.concatenate(weights), minlength=size)
+    return out.reshape(shape)

@@ -53,6 +53,7 @@ from ..physics.stiffness import (
     stencil_offset,
 )
 from . import checkpoint, struct_copy
+from .envelope import Envelope, envelope_pattern, pin
 from .fields import State, clear_rows
 from .guard import SimulationError
 from .implicit_heat import StepHeat
@@ -236,6 +237,7 @@ class ImplicitStepper:
         self.last = StepReport()
         self.newton_total = 0
         self.linear: LinearSolver | None = None
+        self.envelope = Envelope() if envelope_pattern(case) else None  # solver/envelope.py
         self._slots = WIDTH**st.cfg.dim * st.cfg.dim
 
     def advance(self, n: int) -> None:
@@ -291,12 +293,13 @@ class ImplicitStepper:
         self.heat.advance()
         begin(st)
         free = struct_copy.to_numpy(st.implicit.numbering, ("free",))["free"]
-        flat = free.reshape(-1) != 0
+        unknown = free != 0 if self.envelope is None else self.envelope.unknowns(st, free)
+        flat = unknown.reshape(-1)
         dof = np.full(flat.shape, -1, dtype=np.int32)
         n = int(flat.sum())
         dof[flat] = np.arange(n, dtype=np.int32)
         struct_copy.from_numpy(st.implicit.numbering, {"dof": dof.reshape(free.shape)})
-        dof_node = np.ascontiguousarray(np.argwhere(free != 0).astype(np.int32))
+        dof_node = np.ascontiguousarray(np.argwhere(unknown).astype(np.int32))
         if st.cfg.matrix_free:  # the fixed rows stay on the grid (implicit_system.FixedRows)
             rhs, v0, none = np.empty(n), np.empty(n), np.empty((0, 0))
             if n:
@@ -309,6 +312,7 @@ class ImplicitStepper:
         rhs, v0 = np.empty(n), np.empty(n)
         if n:
             gather(st, dof_node, cols, fixed, rhs, v0, Part.FIXED)
+            pin(fixed, dof_node, free)  # the envelope's unknowns not free in this step
         slots = cols >= 0
         indptr = np.concatenate([[0], np.cumsum(slots.sum(axis=1))])
         return GridSystem(dof_node, slots, cols[slots], indptr, fixed[slots], rhs, v0)

@@ -68,7 +68,8 @@ def gather(
     part: ti.i32,
 ):
     """Row k of the fixed matrix or of the tangent (the WIDTH^dim x dim slots of node-component
-    k; cols -1 where the neighbour's component is not an unknown) and a vector, as ``part``
+    k; cols -1 where the neighbour's component is not an unknown, the entry 0 where either
+    component is not free: an unknown the envelope pins) and a vector, as ``part``
     (:class:`Part`) says: FIXED the columns, the right-hand side m v^n / dt + f into vec and v^n
     into guess; TANGENT and FORCE the internal force into vec; RHS the right-hand side and v^n
     alone. One kernel for the four (a template per part would compile four)."""
@@ -86,19 +87,22 @@ def gather(
                         c = st.implicit.dof[J][b]
                     value = 0.0
                     if c >= 0:
-                        if part == Part.FIXED:
-                            if a == b:  # a scalar times the identity (ImplicitFields)
-                                value = st.implicit.fixed[I, o]
-                        elif ti.static(not st.cfg.matrix_free):
-                            value = st.implicit.tangent[I, o, a, b]
+                        # an unknown the step pins (solver/envelope.py) is coupled to nothing
+                        if st.implicit.free[I][a] != 0 and st.implicit.free[J][b] != 0:
+                            if part == Part.FIXED:
+                                if a == b:  # a scalar times the identity (ImplicitFields)
+                                    value = st.implicit.fixed[I, o]
+                            elif ti.static(not st.cfg.matrix_free):
+                                value = st.implicit.tangent[I, o, a, b]
                     vals[k, slot] = value
                     if part == Part.FIXED:
                         cols[k, slot] = c
+        free = ti.cast(st.implicit.free[I][a], float)  # 0: pinned, no force, at rest
         if part == Part.FIXED or part == Part.RHS:
-            vec[k] = nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]
+            vec[k] = (nd.mass[I] * nd.v_old[I][a] / st.scalars.dt[None] + nd.force[I][a]) * free
             guess[k] = nd.v[I][a]
         else:
-            vec[k] = st.implicit.internal[I][a]
+            vec[k] = st.implicit.internal[I][a] * free
 
 
 @ti.kernel

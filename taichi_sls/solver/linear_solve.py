@@ -83,9 +83,11 @@ def linear_solver(case: Case, n: int, assembled: bool = False) -> str:
 
 @dataclass
 class SolveStats:
-    """Work done so far: factorizations (or multigrid set-ups) and CG iterations."""
+    """Work done so far: factorizations (or multigrid set-ups), those of a new pattern (a new
+    analysis), CG iterations and solves."""
 
     factorizations: int = 0
+    analyses: int = 0
     cg_iterations: int = 0
     solves: int = 0
 
@@ -231,6 +233,7 @@ class LinearSolver:
         if self.how == "direct":
             try:
                 if new_pattern or self._factor is None:
+                    self.stats.analyses += 1
                     self._factor = DirectFactor(A, self.nodes, self.backend)
                 else:
                     self._factor.update(A)

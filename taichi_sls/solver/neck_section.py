@@ -170,18 +170,21 @@ def trilinear(field: np.ndarray, h: float, off: int, p: np.ndarray, outside: flo
     """A node field (array index i at x = (i - off) h) interpolated trilinearly at the points
     p (..., 3) (m); ``outside`` beyond the arrays."""
     u = p / h + off
-    i = np.floor(u).astype(int)
+    i = np.floor(u).astype(np.intp)
     f = u - i
+    g = 1.0 - f
     ok = np.all((i >= 0) & (i < np.array(field.shape) - 1), axis=-1)
-    i = np.where(ok[..., None], i, 0)
+    stride = np.array(field.strides) // field.itemsize
+    base = np.where(ok, i @ stride, 0)  # flat index of each corner (0, 0, 0)
+    flat = field.ravel()
     out = np.zeros(p.shape[:-1])
     for a in (0, 1):
-        wa = f[..., 0] if a else 1.0 - f[..., 0]
+        wa = f[..., 0] if a else g[..., 0]
         for b in (0, 1):
-            wb = f[..., 1] if b else 1.0 - f[..., 1]
+            wab = wa * (f[..., 1] if b else g[..., 1])
             for c in (0, 1):
-                wc = f[..., 2] if c else 1.0 - f[..., 2]
-                out += wa * wb * wc * field[i[..., 0] + a, i[..., 1] + b, i[..., 2] + c]
+                wc = f[..., 2] if c else g[..., 2]
+                out += wab * wc * flat[base + (a * stride[0] + b * stride[1] + c * stride[2])]
     return np.where(ok, out, outside)
 
 
@@ -231,8 +234,19 @@ def section_areas(c: np.ndarray, step: float) -> np.ndarray:
     solid = ndimage.binary_fill_holes(c >= 0.0, structure=IN_PLANE)
     c = np.where(solid & (c < 0.0), 0.0, c)  # a hole's nodes count as material
     sw, se, nw, ne = c[:, :-1, :-1], c[:, 1:, :-1], c[:, :-1, 1:], c[:, 1:, 1:]
-    frac = _triangle_fraction(sw, se, ne) + _triangle_fraction(sw, ne, nw)
+    frac = _cut_fraction(sw, se, ne) + _cut_fraction(sw, ne, nw)
     return 0.5 * step * step * frac.sum(axis=(1, 2))
+
+
+def _cut_fraction(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """:func:`_triangle_fraction` of each triangle, the cut computed only on the triangles the
+    interface crosses (few of a section's lattice): 1 inside, 0 outside."""
+    full = (a >= 0) & (b >= 0) & (c >= 0)
+    cut = (a >= 0) | (b >= 0) | (c >= 0)
+    cut &= ~full
+    out = full.astype(float)
+    out[cut] = _triangle_fraction(a[cut], b[cut], c[cut])
+    return out
 
 
 def plane_basis(e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

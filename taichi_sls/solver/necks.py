@@ -86,7 +86,7 @@ class Necks:
         if self.case.contact.neck_section == "centres" or self.state.cfg.dim == 3:
             if not self.contacts:
                 return 0.0, 0.0
-            w = self.necks_m(measure)[0]
+            w = self.necks_m(measure, self.contacts[:1])[0]  # the first contact's alone
             return w, w
         lo, hi = sorted(self.body_centres_m()[:2, 0])
         cfg = self.state.cfg
@@ -119,18 +119,22 @@ class Necks:
             return raw
         return filtered_colour(raw)
 
-    def necks_m(self, measure: str | None = None) -> list[float]:
-        """The neck of every contact (m), in the order of ``contacts``: the narrowest section
-        across the line of the two bodies' mass centres, between the outermost crossings of the
-        interface (:func:`taichi_sls.solver.neck_section.neck_section`), out to the pair's reach."""
-        if not self.contacts:
+    def necks_m(
+        self, measure: str | None = None, contacts: list[tuple[int, int]] | None = None
+    ) -> list[float]:
+        """The neck of every contact (m), in the order of ``contacts`` (default: all the
+        seeded ones): the narrowest section across the line of the two bodies' mass centres,
+        between the outermost crossings of the interface
+        (:func:`taichi_sls.solver.neck_section.neck_section`), out to the pair's reach."""
+        contacts = self.contacts if contacts is None else contacts
+        if not contacts:
             return []
         measure = measure or self.neck_measure()
         if self.reads_kernel(measure):
             everyone = np.arange(len(self.mass))
-            return self._kernel_necks(lambda a, b: everyone)
+            return self._kernel_necks(lambda a, b: everyone, contacts)
         field = self.material_field(measure, "centres")
-        return self._contact_necks(lambda a, b: field)
+        return self._contact_necks(lambda a, b: field, contacts)
 
     def reads_kernel(self, measure: str) -> bool:
         """Whether the sections across the centres read the points' own kernel colour
@@ -138,14 +142,14 @@ class Necks:
         no node field (solver/kernel_colour.py)."""
         return measure == "colour" and self.case.contact.neck_colour == "kernel"
 
-    def _kernel_necks(self, members_of) -> list[float]:
-        """The neck of every contact on the kernel colour of the points ``members_of(a, b)``
-        (indices), rastered over the box the contact's sections span."""
+    def _kernel_necks(self, members_of, contacts: list[tuple[int, int]]) -> list[float]:
+        """The neck of each of ``contacts`` on the kernel colour of the points
+        ``members_of(a, b)`` (indices), rastered over the box the contact's sections span."""
         centre, r, cfg = self.body_centres_m(), self.body_radii_m, self.state.cfg
         pts = point_arrays(self.state, ("x", "volume0", "J"))
         x, volume = pts["x"], pts["volume0"] * pts["J"]
         necks = []
-        for a, b in self.contacts:
+        for a, b in contacts:
             sel = members_of(a, b)
             reach = pair_reach(r[a], r[b], cfg.dim)
             necks.append(
@@ -153,8 +157,8 @@ class Necks:
             )
         return necks
 
-    def _contact_necks(self, field_of) -> list[float]:
-        """neck_section of every contact on ``field_of(a, b)``, sampled out to
+    def _contact_necks(self, field_of, contacts: list[tuple[int, int]]) -> list[float]:
+        """neck_section of each of ``contacts`` on ``field_of(a, b)``, sampled out to
         :func:`~taichi_sls.solver.neck_section.pair_reach`: the coalesced end state of the
         pair, so a neck is followed past the bodies' initial diameter. 3D:
         the diameter 2 sqrt(A / pi) of the section."""
@@ -168,7 +172,7 @@ class Necks:
                 centre[b],
                 pair_reach(r[a], r[b], cfg.dim),
             )[0]
-            for a, b in self.contacts
+            for a, b in contacts
         ]
 
     def body_centres_m(self, initial: bool = False) -> np.ndarray:
@@ -206,7 +210,9 @@ class Necks:
         bounds = np.searchsorted(body[order], np.arange(len(self.body_radii_m) + 1))
         members = [order[bounds[b] : bounds[b + 1]] for b in range(len(self.body_radii_m))]
         if self.reads_kernel("colour"):
-            return self._kernel_necks(lambda a, b: np.concatenate([members[a], members[b]]))
+            return self._kernel_necks(
+                lambda a, b: np.concatenate([members[a], members[b]]), self.contacts
+            )
         x, weight = point_arrays(self.state, ("x",))["x"], self.colour_weights()
         shape = (cfg.nx, cfg.ny) if cfg.dim == 2 else (cfg.nx, cfg.ny, cfg.nz)
 
@@ -215,4 +221,4 @@ class Necks:
             raw = point_colour(x[sel], weight[sel], cfg.h, cfg.lp, cfg.off, shape)
             return self.section_colour(raw) - 0.5
 
-        return self._contact_necks(colour)
+        return self._contact_necks(colour, self.contacts)

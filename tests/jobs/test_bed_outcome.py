@@ -13,7 +13,12 @@ from helpers import PAPER_SCENE, deep_update, make_case
 
 from taichi_sls.io.series import read_series
 from taichi_sls.jobs.bed_layer import melt_extent, relative_density
-from taichi_sls.jobs.bed_outcome import BED_SERIES, contact_geometry, neck_regions
+from taichi_sls.jobs.bed_outcome import (
+    BED_SERIES,
+    ContactHistory,
+    contact_geometry,
+    neck_regions,
+)
 from taichi_sls.jobs.case_run import run_case
 from taichi_sls.jobs.outcome import neck_region
 from taichi_sls.solver.contacts import fillet, point_colour
@@ -179,6 +184,26 @@ def test_pair_colour_is_the_steps_p2g(tmp_path):
     mine = point_colour(x, weight, cfg.h, cfg.lp, cfg.off, (cfg.nx, cfg.ny))
     assert np.abs(mine - sim.necks.raw_colour()).max() < 1e-12
     assert len(sim.necks.pair_necks_m()) == len(TANGENT)
+    # a subset of the contacts reads what the whole list reads for them (the monitors' contact
+    # line reads the first alone)
+    every = sim.necks.necks_m("colour")
+    for k in (0, len(TANGENT) - 1):
+        assert sim.necks.necks_m("colour", sim.contacts[k : k + 1]) == [every[k]]
+
+
+def test_the_neck_regions_are_read_again_only_when_the_points_move_in_order(tmp_path):
+    """The contact record keeps each contact's neck region while the points' start positions
+    keep their order, and reads it again when they are put in another order."""
+    sim = Simulation(_bed_case(tmp_path, 0.85))
+    history = ContactHistory(sim)
+    first = history.regions(sim)
+    assert history.regions(sim) is first
+    order = np.random.default_rng(0).permutation(len(sim.scene.body))
+    sim._permute(order)
+    moved = history.regions(sim)
+    fresh = neck_regions(sim, history.points, history.normals)
+    assert all(np.array_equal(a, b) for a, b in zip(moved, fresh, strict=True))
+    assert all(np.array_equal(a[order], b) for a, b in zip(first, moved, strict=True))
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -54,13 +54,15 @@ RUNS: dict[str, tuple[str, list[str], bool]] = {
 BED_OUTCOME_KEPT = ("fused", "no_verdict")
 # Intended change of issue #53: a run with implicit steps records its linear solves in the
 # summary (``linear_solves``), a block the records before it lack; checked here for its keys
-# (``direct_solver``: the factorization's library, time.direct_solver, added with it)
+# (``direct_solver``: the factorization's library, time.direct_solver, added with it;
+# ``analyses``: the factorizations of a new pattern, with time.direct_pattern)
 LINEAR_SOLVES_KEYS = {
     "solver",
     "direct_solver",
     "newton_iterations",
     "solves",
     "factorizations",
+    "analyses",
     "cg_iterations",
     "last_residual",
 }

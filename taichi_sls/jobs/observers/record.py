@@ -21,7 +21,8 @@ def linear_solves(sim: Simulation) -> dict[str, Any]:
     """The implicit steps' solves since the run (or its resume) started: the linear solver of
     the last step (time.linear_solver) and its direct factorization's library
     (time.direct_solver, where it factorizes), Newton iterations, linear solves, factorizations (or
-    multigrid set-ups), conjugate-gradient iterations and the last step's relative residual."""
+    multigrid set-ups), those of a new pattern (``analyses``: a new elimination order and
+    symbolic factor), conjugate-gradient iterations and the last step's relative residual."""
     imp = sim.implicit
     stats = getattr(imp.linear, "stats", None)
     return {
@@ -30,6 +31,7 @@ def linear_solves(sim: Simulation) -> dict[str, Any]:
         "newton_iterations": int(imp.newton_total),
         "solves": stats.solves if stats is not None else 0,
         "factorizations": stats.factorizations if stats is not None else 0,
+        "analyses": stats.analyses if stats is not None else 0,
         "cg_iterations": stats.cg_iterations if stats is not None else 0,
         "last_residual": float(imp.last.residual),
     }
