@@ -43,7 +43,7 @@ from .frame_panels import (
     temperature_cmap,
 )
 from .surface3d import SURFACE_LEVEL, ColourGrid, Surface, colour_grid, surface
-from .surface_image import OrthographicView, Projection, draw_surface, fit_box
+from .surface_image import OrthographicView, Projection, box_edges, draw_surface, fit_box
 
 # the light: from above (y), in front (-z: the viewer's side) and to the left (-x)
 LIGHT = np.array([-0.4, 1.0, -0.6]) / np.linalg.norm([-0.4, 1.0, -0.6])
@@ -218,13 +218,6 @@ class Frame3DPainter:
 
     def close(self) -> None:
         self._fig = None
-
-
-def box_edges(box: np.ndarray) -> np.ndarray:
-    """The 12 edges (12, 2, 3) of the box ((lo, hi) per axis, (3, 2))."""
-    corners = np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T  # index: 4i + 2j + k
-    pairs = [(a, a | bit) for bit in (4, 2, 1) for a in range(8) if not a & bit]
-    return np.array([(corners[a], corners[b]) for a, b in pairs])
 
 
 def scale_bar(ax: Any, proj: Projection, width_um: float) -> None:

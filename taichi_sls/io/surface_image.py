@@ -55,7 +55,7 @@ def fit_box(view: OrthographicView, box: np.ndarray, width_px: int) -> Projectio
     """The projection that fits the box ((lo, hi) per plot axis, (3, 2)) into an image
     ``width_px`` wide, its height as the box's view needs."""
     right, up, toward = view.axes()
-    corners = np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T
+    corners = box_corners(box)
     sx, sy = corners @ right, corners @ up
     span_x, span_y = np.ptp(sx), np.ptp(sy)
     scale = width_px * (1.0 - 2.0 * MARGIN) / span_x
@@ -64,6 +64,19 @@ def fit_box(view: OrthographicView, box: np.ndarray, width_px: int) -> Projectio
     return Projection(
         right, up, toward, sx.min() - pad_x, sy.max() + pad_y, scale, (width_px, height_px)
     )
+
+
+def box_corners(box: np.ndarray) -> np.ndarray:
+    """The 8 corners (8, 3) of the box ((lo, hi) per axis, (3, 2)), corner 4i + 2j + k at
+    (box[0, i], box[1, j], box[2, k])."""
+    return np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T
+
+
+def box_edges(box: np.ndarray) -> np.ndarray:
+    """The 12 edges (12, 2, 3) of the box ((lo, hi) per axis, (3, 2))."""
+    corners = box_corners(box)
+    pairs = [(a, a | bit) for bit in (4, 2, 1) for a in range(8) if not a & bit]
+    return np.array([(corners[a], corners[b]) for a, b in pairs])
 
 
 def draw_surface(

@@ -4,9 +4,8 @@ triangle surface, the nearer faces over the farther ones."""
 import numpy as np
 from test_frames3d import _lattice_sphere
 
-from taichi_sls.io.frames3d import box_edges
 from taichi_sls.io.surface3d import colour_grid, surface
-from taichi_sls.io.surface_image import OrthographicView, draw_surface, fit_box
+from taichi_sls.io.surface_image import OrthographicView, box_edges, draw_surface, fit_box
 
 VIEW = OrthographicView(elev_deg=25.0, azim_deg=-60.0)
 BOX = np.array([(-12.0, 12.0)] * 3)

@@ -4,7 +4,7 @@ analysis of the factorization only when the material leaves the envelope."""
 
 import numpy as np
 import pytest
-from test_matrix_free import pair
+from test_matrix_free import pair, pair3d_steps
 
 from taichi_sls.config import case_from_dict, load_case
 from taichi_sls.solver.envelope import envelope_pattern
@@ -56,10 +56,7 @@ def test_implicit_3d_steps_are_the_same_in_the_envelope():
     step's nodes change, and stay within the envelope of the fourth)."""
     positions, analyses, iterations = {}, {}, {}
     for mode in ("step", "envelope"):
-        data = pair(3, 4.0, "direct", dt_s=1e-3)
-        data["time"]["direct_pattern"] = mode
-        sim = Simulation(case_from_dict(data))
-        sim.advance_to(5 * sim.dt)
+        sim = pair3d_steps(5, direct_pattern=mode)
         positions[mode] = sim.state.points.x.to_numpy()
         analyses[mode] = sim.implicit.linear.stats.analyses
         iterations[mode] = sim.implicit.newton_total

@@ -33,6 +33,16 @@ def pair(dim: int, h_um: float, solver: str, dt_s: float | None = None) -> dict:
     }
 
 
+def pair3d_steps(steps: int, **time) -> Simulation:
+    """The molten 3D pair (h = 4 um, direct solves, a fixed 1 ms step) after ``steps`` steps,
+    with the ``time`` keys given."""
+    data = pair(3, 4.0, "direct", dt_s=1e-3)
+    data["time"].update(time)
+    sim = Simulation(case_from_dict(data))
+    sim.advance_to(steps * sim.dt)
+    return sim
+
+
 def _newton_system(case: dict):
     sim = Simulation(case_from_dict(case))
     sys_ = sim.implicit.prepare()

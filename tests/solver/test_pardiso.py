@@ -8,14 +8,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from helpers import grid_rows
-from test_matrix_free import pair
+from test_matrix_free import pair3d_steps
 
-from taichi_sls.config import CaseError, case_from_dict, load_case
+from taichi_sls.config import CaseError, load_case
 from taichi_sls.solver import linear_solve
 from taichi_sls.solver.direct_factor import DirectFactor
 from taichi_sls.solver.linear_solve import LinearSolver, direct_backend
 from taichi_sls.solver.pardiso import PardisoFactor, available
-from taichi_sls.solver.simulation import Simulation
 
 needs_mkl = pytest.mark.skipif(not available(), reason="MKL (the mkl package) is not installed")
 
@@ -97,10 +96,7 @@ def test_implicit_3d_steps_are_the_same_on_either_library():
     scale, would allow far more), and the same Newton iterations."""
     positions, iterations = {}, {}
     for backend in ("cholmod", "pardiso"):
-        data = pair(3, 4.0, "direct", dt_s=1e-3)
-        data["time"]["direct_solver"] = backend
-        sim = Simulation(case_from_dict(data))
-        sim.advance_to(3 * sim.dt)
+        sim = pair3d_steps(3, direct_solver=backend)
         positions[backend] = sim.state.points.x.to_numpy()
         iterations[backend] = sim.implicit.newton_total
         assert sim.implicit.linear.backend == backend
