@@ -59,7 +59,6 @@ class Envelope:
 
     def __init__(self) -> None:
         self.nodes: np.ndarray | None = None  # (grid) bool
-        self.builds = 0
         self._wall_free: np.ndarray | None = None  # (grid, dim) bool
 
     def unknowns(self, st: State, free: np.ndarray) -> np.ndarray:
@@ -74,7 +73,6 @@ class Envelope:
         if self.nodes is None or np.any(free_nodes & ~self.nodes):
             mass = struct_copy.to_numpy(st.nodes, ("mass",))["mass"]
             self.nodes = (mass > ENVELOPE_MASS_FRACTION * st.cfg.mass_cut) | free_nodes
-            self.builds += 1
         return self.nodes[..., None] & self._wall_free
 
 
