@@ -19,17 +19,19 @@ from taichi_sls.studies.process import plots
 from taichi_sls.studies.process.design import (
     BED_TEMPERATURE_KEYS,
     BED_WIDTH_UM,
+    ENERGY_POWERS_3D_W,
     VISCOSITY_PREFACTOR,
     bed_temperature_sweep,
     energy_sweep,
     sensitivity_sweep,
 )
 from taichi_sls.studies.process.measured import MeasuredDataError, load_measured
-from taichi_sls.studies.process.study import report
+from taichi_sls.studies.process.study import measured_parts, report
 from taichi_sls.studies.process.summary import bed_summary, sensitivity_summary
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = ROOT / "cases" / "machine_layer.toml"
+BASE_3D = ROOT / "cases" / "machine_layer3d.toml"
 
 
 def _overrides(case) -> dict[str, str]:
@@ -102,6 +104,59 @@ def test_the_energy_sweep_spans_the_andrew_numbers_with_centred_tracks():
         # two tracks centred on the reduced bed, whatever the hatch
         assert float(o["lasers.0.x_start_um"]) + 0.5 * h == pytest.approx(0.5 * BED_WIDTH_UM)
         assert float(o["lasers.0.hatch_um"]) == h
+
+
+def test_the_3d_energy_sweep_sweeps_power_over_the_bundled_layer_and_draws_other_beds():
+    sweep = energy_sweep(BASE_3D)
+    base = load_case(BASE_3D)
+    las = base.lasers[0]
+    energies = [c for c in sweep.cases if c.params["seed"] == 1]
+    assert [c.params["power_W"] for c in energies] == list(ENERGY_POWERS_3D_W)
+    andrew = [c.params["andrew_J_mm2"] for c in energies]
+    assert len(andrew) >= 5 and min(andrew) <= 0.0125 and max(andrew) >= 0.04
+    for c in sweep.cases:
+        o = _overrides(c)
+        # the bed and layer time as bundled, the hold's step by its error
+        assert "bed.x_range_um" not in o and "time.end_s" not in o
+        assert o["time.strain_control"] == "error"
+        # the two tracks centred across the 180 um bed: z = 40 and 140 um as bundled
+        assert float(o["lasers.0.z_start_um"]) == pytest.approx(las.z_start_um)
+        assert "lasers.0.x_start_um" not in o
+    draws = [c for c in sweep.cases if c.params["seed"] != 1]
+    assert [c.params["seed"] for c in draws] == [2, 3]
+    for c in draws:
+        assert _overrides(c)["bed.seed"] == str(c.params["seed"])
+        assert c.params["power_W"] == las.power_W
+        assert "lasers.0.power_W" not in _overrides(c)  # the base's own
+    # the 3D sensitivity: the same bed draws, no plateau row (the layer time is the base's)
+    factors = {c.params["factor"] for c in sensitivity_sweep(BASE_3D).cases}
+    assert "another bed (seed)" in factors and "layer time" not in factors
+
+
+def test_the_3d_density_figure_sets_the_measured_part_and_powder_beside_it(tmp_path):
+    lines, bands = measured_parts(load_measured())
+    # Westphal & Seitz, Table 7 (data/pa12): the cuboid's porosity 1.15-2.96 % by pycnometry and
+    # micrographs, 11.45 % by Archimedes; the powder 463 kg/m3 over 1,010 (bulk) and 950
+    assert [round(p.relative_density, 4) for p in lines] == [0.8855]
+    assert bands[0][1:] == pytest.approx((1 - 0.0296, 1 - 0.0115), abs=1e-12)
+    assert bands[1][1:] == pytest.approx((0.463 / 1.01, 0.463 / 0.950), abs=1e-12)
+    rows = [
+        _row(0.70 + 0.01 * k, power_W=P, speed_m_s=8.0, hatch_um=100.0, seed=1)
+        for k, P in enumerate(ENERGY_POWERS_3D_W)
+    ]
+    rows += [_row(0.72, power_W=25.0, speed_m_s=8.0, hatch_um=100.0, seed=s) for s in (2, 3)]
+    for r in rows:
+        r["andrew_J_mm2"] = r["power_W"] / (8.0 * 100.0)
+    out = tmp_path / "out"
+    _results(out / "density_energy" / "results.csv", rows)
+    result = report(out, tmp_path / "figs", str(BASE_3D), [])
+    # by Andrew number, then seed; the seed kept in the summary
+    order = [(r["power_W"], r["seed"]) for r in result["energy"]]
+    assert order[order.index((25.0, 1)) :][:3] == [(25.0, 1), (25.0, 2), (25.0, 3)]
+    assert len(order) == len(rows)
+    assert (tmp_path / "figs" / "density_energy_3d.png").stat().st_size > 20_000
+    assert (tmp_path / "figs" / "density_energy_3d.csv").is_file()
+    assert not (tmp_path / "figs" / "density_energy.png").exists()
 
 
 def test_the_sensitivity_scales_the_bases_own_values():

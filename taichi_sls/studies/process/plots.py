@@ -4,6 +4,7 @@ points, density against the bed temperature, and the tornado of the sensitivitie
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -18,11 +19,14 @@ from .measured import MeasuredPoint  # noqa: E402
 
 DPI = 110
 HATCH_MARKERS = {100.0: "o", 150.0: "s", 200.0: "^"}
-NOT_COMPARABLE = (
-    "2D: a section of discs across the tracks. Compare how the density rises with energy and\n"
+NOT_COMPARABLE = {
+    2: "2D: a section of discs across the tracks. Compare how the density rises with energy and\n"
     "where it levels off, not its level: a 2D disc packing starts near 0.83, a 3D powder bed\n"
-    "near 0.46, and a part's pores are 3D (open or closed), which no 2D section counts."
-)
+    "near 0.46, and a part's pores are 3D (open or closed), which no 2D section counts.",
+    3: "3D: one layer of spheres after its layer time, with no layer above. A part's density is\n"
+    "that of hundreds of layers, each remelted by the next and weighed down by those above;\n"
+    "compare how the density rises with energy and where it levels off, not its level.",
+}
 
 
 def _save(fig: Figure, png: str | Path) -> Path:
@@ -33,15 +37,24 @@ def _save(fig: Figure, png: str | Path) -> Path:
 
 
 def plot_density_energy(
-    rows: list[dict[str, Any]], measured: list[MeasuredPoint], png: str | Path
+    rows: list[dict[str, Any]],
+    measured: list[MeasuredPoint],
+    png: str | Path,
+    dim: int = 2,
+    bands: Sequence[tuple[str, float, float]] = (),
 ) -> Path:
     """Left: the simulated layer's relative density before (x) and after the layer time (filled,
-    marker by hatch) against the Andrew number, with the published points: a source with an
-    energy density as a labelled diamond, one without as a labelled horizontal line. Right: the
-    simulated density gain against the Andrew number."""
-    fig = Figure(figsize=(12.5, 5.6), layout="constrained")
+    marker by hatch; other draws of the bed, rows whose ``seed`` differs from the first row's,
+    hollow) against the Andrew number, with the published points: a source with an energy
+    density as a labelled diamond, one without as a labelled horizontal line, and ``bands``
+    (label, low, high) as shaded ranges of relative density. Right: the simulated density gain
+    against the Andrew number."""
+    fig = Figure(figsize=(12.5, 5.6 if dim == 2 else 6.6), layout="constrained")
     ax, gx = fig.subplots(1, 2, width_ratios=[1.15, 1])
     e_max = max([r["andrew_J_mm2"] for r in rows] + [0.06])
+    first_seed = rows[0].get("seed") if rows else None
+    draws = [r for r in rows if r.get("seed") != first_seed]
+    rows = [r for r in rows if r.get("seed") == first_seed]
     for h in sorted({r["hatch_um"] for r in rows}):
         sel = [r for r in rows if r["hatch_um"] == h]
         kw = {"marker": HATCH_MARKERS.get(h, "D"), "ls": "none", "ms": 7}
@@ -49,7 +62,7 @@ def plot_density_energy(
             [r["andrew_J_mm2"] for r in sel],
             [r["bed.relative_density.final"] for r in sel],
             color="C0",
-            label=f"simulated 2D layer, after the hold (hatch {h:g} um)",
+            label=f"simulated {dim}D layer, after the hold (hatch {h:g} um)",
             **kw,
         )
         gx.plot(
@@ -59,13 +72,20 @@ def plot_density_energy(
             label=f"hatch {h:g} um",
             **kw,
         )
+    if draws:
+        seeds = ", ".join(str(s) for s in sorted({r["seed"] for r in draws}))
+        kw = {"marker": "o", "ls": "none", "ms": 9, "mfc": "none", "color": "C0"}
+        x = [r["andrew_J_mm2"] for r in draws]
+        ax.plot(x, [r["bed.relative_density.final"] for r in draws], **kw)
+        ax.plot([], [], label=f"the same on other beds (seeds {seeds})", **kw)
+        gx.plot(x, [100 * r["gain"] for r in draws], label=f"other beds (seeds {seeds})", **kw)
     if rows:
         ax.plot(
-            [r["andrew_J_mm2"] for r in rows],
-            [r["bed.relative_density.initial"] for r in rows],
+            [r["andrew_J_mm2"] for r in rows + draws],
+            [r["bed.relative_density.initial"] for r in rows + draws],
             "x",
             color="0.5",
-            label="simulated 2D layer, settled powder before the scan",
+            label=f"simulated {dim}D layer, settled powder before the scan",
         )
         # the hatch most rows share, joined: power and speed at one hatch
         common = max(
@@ -73,6 +93,8 @@ def plot_density_energy(
         )
         line = sorted((r for r in rows if r["hatch_um"] == common), key=lambda r: r["andrew_J_mm2"])
         gx.plot([r["andrew_J_mm2"] for r in line], [100 * r["gain"] for r in line], "-", lw=0.8)
+    for k, (label, lo, hi) in enumerate(bands):
+        ax.axhspan(lo, hi, color=f"C{len(measured) + k + 1}", alpha=0.2, label=label)
     for i, p in enumerate(measured):
         rel = p.relative_density
         if p.energy_J_mm2 is not None:
@@ -100,20 +122,23 @@ def plot_density_energy(
     ax.set_xlabel("Andrew number P / (v h) (J/mm$^2$)")
     ax.set_ylabel("relative density")
     ax.set_title("PA12 layer: relative density against energy density")
-    ax.legend(loc="center", bbox_to_anchor=(0.5, 0.5), fontsize=8)
+    if dim == 2:
+        ax.legend(loc="center", bbox_to_anchor=(0.5, 0.5), fontsize=8)
+    else:  # the 3D layer's points span the middle of the axes: the legend below both panels
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=8)
     ax.text(
-        0.98,
+        0.98 if dim == 2 else 0.02,
         0.16,
-        NOT_COMPARABLE,
+        NOT_COMPARABLE[dim],
         transform=ax.transAxes,
         fontsize=8,
-        ha="right",
+        ha="right" if dim == 2 else "left",
         multialignment="left",
     )
     gx.set_xlim(0.0, 1.1 * e_max)
     gx.set_xlabel("Andrew number P / (v h) (J/mm$^2$)")
     gx.set_ylabel("density gained over the layer time (percentage points)")
-    gx.set_title("simulated 2D layer: density gained")
+    gx.set_title(f"simulated {dim}D layer: density gained")
     gx.legend(fontsize=8)
     gx.grid(alpha=0.3)
     return _save(fig, png)

@@ -9,7 +9,8 @@ Each study is a sweep (:mod:`.design`) whose rows go to ``OUT/<sweep>/results.cs
 finish (a rerun skips finished cases, as ``taichi-sls sweep`` does); then ``OUT/process.json``
 holds the summaries (:mod:`.summary`) and ``density_energy.png``, ``bed_temperature.png`` and
 ``density_sensitivity.png`` are drawn into ``--figures`` (default OUT; another folder also
-gets the results tables as ``<sweep>.csv`` and the summaries as ``process_study.json``).
+gets the results tables as ``<sweep>.csv`` and the summaries as ``process_study.json``). A 3D
+base (``cases/machine_layer3d.toml``) names them with ``_3d`` (``density_energy_3d.png``, ...).
 ``--base`` names another hatched layer (another material, say): the sweeps scale that case's
 own inputs.
 """
@@ -29,7 +30,7 @@ from ...config.loading import add_set_argument
 from ...jobs.sweep.spec import SweepError
 from . import plots, summary
 from .design import DEFAULT_BASE, STUDIES, load_base
-from .measured import MeasuredDataError, load_measured
+from .measured import MeasuredDataError, MeasuredPoint, load_measured
 
 SWEEP_NAMES = {"energy": "density_energy", "bed": "bed_temperature", "sensitivity": "sensitivity"}
 
@@ -44,6 +45,51 @@ def _marks(base: str, extra_set: list[str]) -> dict[str, Any]:
         "melt_onset_C": getattr(mat, "crystallization_C", None),
         "machine_C": (168.0, 175.0),
     }
+
+
+def _dim(base: str, extra_set: list[str]) -> int:
+    return load_base(base, extra_set)[0].domain.dim
+
+
+def measured_parts(
+    measured: list[MeasuredPoint],
+) -> tuple[list[MeasuredPoint], list[tuple[str, float, float]]]:
+    """The measured part and powder of ``data/pa12`` beside a 3D layer: the part's Archimedes
+    porosity as a line, its porosity by pycnometry and micrographs as a band (1 - porosity), and
+    the powder as spread as a band over the consolidated (data sheet) and the bulk density (the
+    largest ``relative_to`` of ``measured``, the file's dense reference)."""
+    from ..validation.measured import load_densities
+
+    records = load_densities()
+    porosity = [r for r in records if r.quantity == "part porosity" and r.unit == "%"]
+    lines = [
+        MeasuredPoint(
+            source="{} ({})".format(*(r.source.split(", ", 1) + [""])[:2]),
+            where=r.specimen,
+            kind=f"{r.method}, porosity {r.value:g} %",
+            material="PA12",
+            process="laser sintering",
+            energy_J_mm2=None,
+            density_g_cm3=1.0 - r.value / 100.0,
+            relative_to_g_cm3=1.0,
+            note="",
+        )
+        for r in porosity
+        if r.method == "Archimedes"
+    ]
+    bands = []
+    closed = [1.0 - r.value / 100.0 for r in porosity if r.method != "Archimedes"]
+    if closed:
+        source = porosity[0].source.split(",")[0]
+        bands.append((f"{source}: a part, pycnometry and micrographs", min(closed), max(closed)))
+    g_cm3 = {"g/cm3": 1.0, "kg/m3": 1e-3}
+    powder = [r.value * g_cm3[r.unit] for r in records if r.quantity == "powder density as spread"]
+    solid = [r.value * g_cm3[r.unit] for r in records if r.quantity == "consolidated density"]
+    if powder and solid and measured:
+        bulk = max(p.relative_to_g_cm3 for p in measured)
+        lo, hi = powder[0] / bulk, powder[0] / min(solid)
+        bands.append(("powder as spread, over the bulk and the consolidated density", lo, hi))
+    return lines, bands
 
 
 def _clean(v: Any) -> Any:
@@ -69,14 +115,23 @@ def report(
     returned."""
     ids = ids or {}
     result: dict[str, Any] = {"base": base, "set": extra_set, "figures": []}
+    dim = _dim(base, extra_set)
+    tag = "" if dim == 2 else f"_{dim}d"  # a 3D base's figures and tables beside the 2D ones
     csv = {k: out / name / "results.csv" for k, name in SWEEP_NAMES.items()}
     if csv["energy"].is_file():
         rows = summary.energy_summary(csv["energy"], ids.get("energy"))
-        keep = ("power_W", "speed_m_s", "hatch_um", "andrew_J_mm2", summary.INITIAL)
+        keep = ("power_W", "speed_m_s", "hatch_um", "andrew_J_mm2", "seed", summary.INITIAL)
         result["energy"] = [
-            {k: r[k] for k in (*keep, summary.FINAL, "gain", "bed.fused_fraction")} for r in rows
+            {k: r[k] for k in (*keep, summary.FINAL, "gain", "bed.fused_fraction") if k in r}
+            for r in rows
         ]
-        png = plots.plot_density_energy(rows, load_measured(), figures / "density_energy.png")
+        measured, bands = load_measured(), []
+        if dim == 3:
+            lines, bands = measured_parts(measured)
+            measured += lines
+        png = plots.plot_density_energy(
+            rows, measured, figures / f"density_energy{tag}.png", dim=dim, bands=bands
+        )
         result["figures"].append(str(png))
     if csv["bed"].is_file():
         bed = summary.bed_summary(csv["bed"], ids.get("bed"))
@@ -85,14 +140,14 @@ def report(
             "rows": [{k: r[k] for k in ("bed_C", summary.FINAL, "gain")} for r in bed["rows"]],
         }
         png = plots.plot_bed_temperature(
-            bed, _marks(base, extra_set), figures / "bed_temperature.png"
+            bed, _marks(base, extra_set), figures / f"bed_temperature{tag}.png"
         )
         result["figures"].append(str(png))
     if csv["sensitivity"].is_file():
         sens = summary.sensitivity_summary(csv["sensitivity"], ids.get("sensitivity"))
         result["sensitivity"] = sens
         if sens["reference"] is not None:
-            png = plots.plot_sensitivity(sens, figures / "density_sensitivity.png")
+            png = plots.plot_sensitivity(sens, figures / f"density_sensitivity{tag}.png")
             result["figures"].append(str(png))
     out.mkdir(parents=True, exist_ok=True)
     text = json.dumps(_clean(result), indent=1) + "\n"
@@ -100,8 +155,8 @@ def report(
     if figures.resolve() != out.resolve():  # the tables beside the figures, for committing
         for k, name in SWEEP_NAMES.items():
             if csv[k].is_file():
-                shutil.copyfile(csv[k], figures / f"{name}.csv")
-        (figures / "process_study.json").write_text(text)
+                shutil.copyfile(csv[k], figures / f"{name}{tag}.csv")
+        (figures / f"process_study{tag}.json").write_text(text)
     return result
 
 

@@ -34,9 +34,10 @@ def _done(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def energy_summary(results_csv: str | Path, ids: set[str] | None = None) -> list[dict[str, Any]]:
-    """The energy sweep's complete rows by increasing Andrew number."""
+    """The energy sweep's complete rows by increasing Andrew number (then hatch, then the bed's
+    seed where a 3D sweep draws other beds)."""
     rows = _done(_rows(results_csv, ids))
-    return sorted(rows, key=lambda r: (r["andrew_J_mm2"], r["hatch_um"]))
+    return sorted(rows, key=lambda r: (r["andrew_J_mm2"], r["hatch_um"], r.get("seed", 0)))
 
 
 def bed_summary(results_csv: str | Path, ids: set[str] | None = None) -> dict[str, Any]:
