@@ -24,8 +24,9 @@ NOT_COMPARABLE = {
     "where it levels off, not its level: a 2D disc packing starts near 0.83, a 3D powder bed\n"
     "near 0.46, and a part's pores are 3D (open or closed), which no 2D section counts.",
     3: "3D: one layer of spheres after its layer time, with no layer above. A part's density is\n"
-    "that of hundreds of layers, each remelted by the next and weighed down by those above;\n"
-    "compare how the density rises with energy and where it levels off, not its level.",
+    "that of hundreds of layers, each remelted by the next and held hot for the hours of the\n"
+    "build: compare how the density rises with energy and where it levels off; its level is a\n"
+    "lower bound.",
 }
 
 
@@ -139,7 +140,7 @@ def plot_density_energy(
     gx.set_xlabel("Andrew number P / (v h) (J/mm$^2$)")
     gx.set_ylabel("density gained over the layer time (percentage points)")
     gx.set_title(f"simulated {dim}D layer: density gained")
-    gx.legend(fontsize=8)
+    gx.legend(fontsize=8, loc="upper left")
     gx.grid(alpha=0.3)
     return _save(fig, png)
 
