@@ -111,12 +111,9 @@ def load_base(base: str | Path, extra_set: Sequence[str] = ()) -> tuple[Case, Be
     """The base case with ``extra_set`` and its [bed] table (the loaded case has made the bed's
     particles bodies); refused unless its first laser scans hatches over a generated bed (2D:
     ``scan = "across"``; 3D: tracks in the bed plane, the bed's range across them given)."""
-    data = read_case_file(find_case(base))
-    for text in extra_set:
-        apply_override(data, text)
+    data = _base_data(base, extra_set)
     lasers = data.get("lasers") or [{}]
-    dim = int((data.get("domain") or {}).get("dim", 2))
-    if dim == 2 and lasers[0].get("scan") != "across":
+    if _dim_of(data) == 2 and lasers[0].get("scan") != "across":
         raise SweepError(
             f"base {base}: lasers.0.scan must be 'across' (a hatched layer, e.g. "
             f"{DEFAULT_BASE}); the process studies sweep its power, speed and hatch"
@@ -129,6 +126,23 @@ def load_base(base: str | Path, extra_set: Sequence[str] = ()) -> tuple[Case, Be
     if getattr(bed, key) is None:
         raise SweepError(f"base {base}: needs bed.{key} (the bed across its tracks)")
     return case, bed
+
+
+def _base_data(base: str | Path, extra_set: Sequence[str] = ()) -> dict[str, Any]:
+    """The base case file's table with ``extra_set`` applied (not validated)."""
+    data = read_case_file(find_case(base))
+    for text in extra_set:
+        apply_override(data, text)
+    return data
+
+
+def _dim_of(data: dict[str, Any]) -> int:
+    return int((data.get("domain") or {}).get("dim", 2))
+
+
+def base_dim(base: str | Path, extra_set: Sequence[str] = ()) -> int:
+    """The base case's ``domain.dim``, read from its file."""
+    return _dim_of(_base_data(base, extra_set))
 
 
 def _across_range_key(case: Case) -> str:
@@ -147,8 +161,7 @@ def _reduction(case_path: Path, reduction: Sequence[str] | None) -> Sequence[str
     """``reduction``, or the base dimension's own (``REDUCTION`` in 2D, ``REDUCTION_3D``)."""
     if reduction is not None:
         return reduction
-    data = read_case_file(find_case(case_path))
-    return REDUCTION_3D if int((data.get("domain") or {}).get("dim", 2)) == 3 else REDUCTION
+    return REDUCTION_3D if base_dim(case_path) == 3 else REDUCTION
 
 
 def _tracks_start(tracks: int, hatch_um: float, width_um: float) -> float:
@@ -323,8 +336,8 @@ def sensitivity_sweep(
     for f in factors(case, bed):
         for level, values in (f.low, f.high):
             settings.append(({"factor": f.label, "level": level}, {**start, **values}))
-    end = load_base(base, list(extra_set))[0].time.end_s
-    if full_layer_time and end != case.time.end_s:  # a 3D base is held its own layer time
+    end = load_base(base, list(extra_set))[0].time.end_s if full_layer_time else case.time.end_s
+    if end != case.time.end_s:  # a 3D base is held its own layer time already
         settings.append(
             ({"factor": "layer time", "level": f"{end:g} s"}, {**start, "time.end_s": end})
         )

@@ -29,7 +29,7 @@ from ...config import CaseError
 from ...config.loading import add_set_argument
 from ...jobs.sweep.spec import SweepError
 from . import plots, summary
-from .design import DEFAULT_BASE, STUDIES, load_base
+from .design import DEFAULT_BASE, STUDIES, base_dim, load_base
 from .measured import MeasuredDataError, MeasuredPoint, load_measured
 
 SWEEP_NAMES = {"energy": "density_energy", "bed": "bed_temperature", "sensitivity": "sensitivity"}
@@ -45,10 +45,6 @@ def _marks(base: str, extra_set: list[str]) -> dict[str, Any]:
         "melt_onset_C": getattr(mat, "crystallization_C", None),
         "machine_C": (168.0, 175.0),
     }
-
-
-def _dim(base: str, extra_set: list[str]) -> int:
-    return load_base(base, extra_set)[0].domain.dim
 
 
 def measured_parts(
@@ -115,7 +111,7 @@ def report(
     returned."""
     ids = ids or {}
     result: dict[str, Any] = {"base": base, "set": extra_set, "figures": []}
-    dim = _dim(base, extra_set)
+    dim = base_dim(base, extra_set)
     tag = "" if dim == 2 else f"_{dim}d"  # a 3D base's figures and tables beside the 2D ones
     csv = {k: out / name / "results.csv" for k, name in SWEEP_NAMES.items()}
     if csv["energy"].is_file():
