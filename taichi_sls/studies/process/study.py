@@ -58,9 +58,13 @@ def measured_parts(
 
     records = load_densities()
     porosity = [r for r in records if r.quantity == "part porosity" and r.unit == "%"]
+
+    def author(source: str) -> str:  # "Westphal & Seitz, <journal>, Table 7": the authors
+        return source.split(", ", 1)[0]
+
     lines = [
         MeasuredPoint(
-            source="{} ({})".format(*(r.source.split(", ", 1) + [""])[:2]),
+            source=f"{author(r.source)} ({r.source[len(author(r.source)) + 2 :]})",
             where=r.specimen,
             kind=f"{r.method}, porosity {r.value:g} %",
             material="PA12",
@@ -74,13 +78,21 @@ def measured_parts(
         if r.method == "Archimedes"
     ]
     bands = []
-    closed = [1.0 - r.value / 100.0 for r in porosity if r.method != "Archimedes"]
-    if closed:
-        source = porosity[0].source.split(",")[0]
-        bands.append((f"{source}: a part, pycnometry and micrographs", min(closed), max(closed)))
+    for source in dict.fromkeys(r.source for r in porosity):  # a band per source, in file order
+        closed = [
+            1.0 - r.value / 100.0
+            for r in porosity
+            if r.source == source and r.method != "Archimedes"
+        ]
+        if closed:
+            label = f"{author(source)}: a part, pycnometry and micrographs"
+            bands.append((label, min(closed), max(closed)))
     g_cm3 = {"g/cm3": 1.0, "kg/m3": 1e-3}
-    powder = [r.value * g_cm3[r.unit] for r in records if r.quantity == "powder density as spread"]
-    solid = [r.value * g_cm3[r.unit] for r in records if r.quantity == "consolidated density"]
+    by_quantity = {
+        q: [r.value * g_cm3[r.unit] for r in records if r.quantity == q and r.unit in g_cm3]
+        for q in ("powder density as spread", "consolidated density")
+    }
+    powder, solid = by_quantity["powder density as spread"], by_quantity["consolidated density"]
     if powder and solid and measured:
         bulk = max(p.relative_to_g_cm3 for p in measured)
         lo, hi = powder[0] / bulk, powder[0] / min(solid)
