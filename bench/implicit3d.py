@@ -7,8 +7,9 @@ layer's hold, where the viscous stiffness outweighs the inertia 1e8 times), at h
 2.5 um (``--quick``: 4 only), each with the direct solver (``direct``: its default library,
 MKL PARDISO where installed; ``direct-cholmod``: CHOLMOD), AMG-CG (pyamg's smoothed
 aggregation with the rigid-body modes) and the matrix-free step (CG with the grid multigrid,
-solver/multigrid.py), the direct one also with the rows stored by blocks
-(``time.implicit_rows = "blocks"``) beside dense ones. The process material
+solver/multigrid.py), the direct and matrix-free ones also with their rows (the matrix-free
+step's: the fixed part's alone) stored by blocks (``time.implicit_rows = "blocks"``: the
+solver's name with "-blocks") beside dense ones. The process material
 (``pa12_process``) with ``--dt``, the paper's PA12 without. After one step (which compiles),
 ``--steps`` steps are timed: the wall time per step and per Newton linear solve, Newton
 iterations, CG iterations per solve (0: the factorization alone), the unknowns, and the
@@ -52,7 +53,14 @@ COLUMNS = [
     "bytes_per_point",
     "host_bytes_per_point",
 ]
-SOLVERS = ("direct", "direct-cholmod", "direct-blocks", "amg", "matrix_free")
+SOLVERS = (
+    "direct",
+    "direct-cholmod",
+    "direct-blocks",
+    "amg",
+    "matrix_free",
+    "matrix_free-blocks",
+)
 LIBRARIES = ("cholmod", "pardiso")  # a direct solver's suffix naming its library
 
 
@@ -206,7 +214,7 @@ def main(args: argparse.Namespace) -> int:
             rows.append(measure(h, solver, args.steps, storage, args.dt, library))
             r = rows[-1]
             print(
-                f"h {r['h_um']:4.1f} um {r['solver']:6s} {r['direct_solver']:7s} {r['rows']:6s} "
+                f"h {r['h_um']:5.2f} um {r['solver']:6s} {r['direct_solver']:7s} {r['rows']:6s} "
                 f"{r['unknowns']:7d} unknowns "
                 f"{r['wall_per_step_s']:7.2f} s/step {r['wall_per_solve_s']:7.3f} s/solve "
                 f"{r['newton_iterations_per_step']:5.2f} Newton/step "
@@ -215,6 +223,7 @@ def main(args: argparse.Namespace) -> int:
                 f"{r['bytes_per_point']} B/point {r['host_bytes_per_point']} B/point on the host",
                 flush=True,
             )
-    write_rows(out / "implicit3d.csv", rows, COLUMNS)
-    atomic_write_text(out / "implicit3d.json", json.dumps(rows, indent=1))
+            # after every row: a long run stopped later keeps the rows measured
+            write_rows(out / "implicit3d.csv", rows, COLUMNS)
+            atomic_write_text(out / "implicit3d.json", json.dumps(rows, indent=1))
     return 0

@@ -17,7 +17,10 @@ CHOLMOD, PARDISO = "cholmod", "pardiso"  # time.direct_solver's libraries
 
 class LinearSolveError(RuntimeError):
     """No factorization of the matrix exists (singular or indefinite), or conjugate gradients
-    with a fresh preconditioner did not converge."""
+    with a fresh preconditioner did not converge. ``advice``: what a case can change."""
+
+    # a node with almost no mass and stiffness leaves the matrix near singular
+    advice = "try a smaller time.dt_s or time.implicit_velocity_penalty = 1e-6"
 
 
 class DirectFactor:

@@ -387,9 +387,8 @@ class ImplicitStepper:
                 )
             except LinearSolveError as e:  # an adaptive run redoes the step smaller
                 raise NewtonError(
-                    f"{where}: Newton's linear solve failed: {e}; a node with almost no mass "
-                    "and stiffness leaves the matrix near singular (docs/record/implicit.md): "
-                    "try a smaller time.dt_s or time.implicit_velocity_penalty = 1e-6"
+                    f"{where}: Newton's linear solve failed: {e}; {e.advice} "
+                    "(docs/record/implicit.md)"
                 ) from e
             fresh = False
             norm0 = np.linalg.norm(R)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
+from threadpoolctl import ThreadpoolController
 
 from ..physics.stiffness import REACH
 from ..physics.tangent_operator import (
@@ -52,6 +53,9 @@ SMOOTHED_FRACTION = 0.1  # Chebyshev damps eigenvalues in [this x lambda_max, la
 
 class MatrixFreeError(LinearSolveError):
     """Conjugate gradients did not reach the tolerance: the message says how far it got."""
+
+    # the velocity penalty is refused with the matrix-free step; the direct solve is exact
+    advice = 'try a smaller time.dt_s, or time.linear_solver = "direct"'
 
 
 def _prolongation_1d(n_fine: int, n_coarse: int, shift: int) -> sp.csr_matrix:
@@ -364,6 +368,20 @@ def _masked_inverse(diag: np.ndarray, free: np.ndarray) -> np.ndarray:
     return np.linalg.inv(safe) * mask
 
 
+_BLAS: ThreadpoolController | None = None
+
+
+def one_blas_thread() -> object:
+    """A context in which numpy's and scipy's BLAS run on one thread. The cycle's dense work is
+    small (the coarsest Cholesky, some thousand unknowns; the prolongation's products), and
+    OpenBLAS's threads spin for a core: where the other core is busy (Taichi's threads, another
+    run, a test worker) a 2-thread call took 75x longer than on one thread."""
+    global _BLAS
+    if _BLAS is None:
+        _BLAS = ThreadpoolController()
+    return _BLAS.limit(limits=1, user_api="blas")
+
+
 class MatrixFreeSolver:
     """The implicit step's linear solves for one step without assembled tangent rows (module
     docstring): the interface of solver/linear_solve.py's LinearSolver, the matrix argument
@@ -387,7 +405,8 @@ class MatrixFreeSolver:
 
     def set_tangent(self) -> None:
         """Take the points' moduli the force pass just kept."""
-        self.multigrid.set_tangent()
+        with one_blas_thread():
+            self.multigrid.set_tangent()
         self.stats.factorizations += 1
 
     def solve(
@@ -395,6 +414,7 @@ class MatrixFreeSolver:
     ) -> np.ndarray:
         """LinearSolver.solve's call; ``refresh`` and ``keys`` unused (a cycle a tangent)."""
         self.stats.solves += 1
-        x, iterations, _ = self.multigrid.solve(b, self.rtol, CG_MAX_ITERATIONS)
+        with one_blas_thread():
+            x, iterations, _ = self.multigrid.solve(b, self.rtol, CG_MAX_ITERATIONS)
         self.stats.cg_iterations += iterations
         return x

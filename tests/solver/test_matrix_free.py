@@ -104,6 +104,42 @@ def test_steps_match_the_direct_solver():
     assert np.abs(positions["direct"] - positions["matrix_free"]).max() <= 1e-5 * h
 
 
+@pytest.mark.slow  # ~20 s: the 3D pair through 0.2 s of its hold, on either solver
+def test_a_3d_pairs_neck_matches_the_direct_solvers():
+    """The molten 3D pair held 0.2 s in steps of 50 ms (viscous steps, several Newton iterations
+    each): its neck grows, and the matrix-free step puts it within 0.1 % of the direct one's
+    (issue #53's bound; both solve each Newton direction to the relative residual 1e-6)."""
+    necks = {}
+    for solver in ("direct", "matrix_free"):
+        sim = Simulation(case_from_dict(pair(3, 4.0, solver, dt_s=5e-2)))
+        start = sim.necks.necks_m()[0]
+        sim.advance_to(4 * sim.dt)
+        necks[solver] = sim.necks.necks_m()[0]
+    assert necks["direct"] > 1.02 * start, (start, necks)
+    assert necks["matrix_free"] == pytest.approx(necks["direct"], rel=1e-3)
+
+
+@pytest.mark.slow  # ~60 s: a molten bed of 8 spheres held 0.1 s, on either solver
+def test_a_beds_density_matches_the_direct_solvers(tmp_path):
+    """machine_layer3d's bed cut to 8 spheres, unsettled, molten at 200 C without the beam and
+    held 0.1 s in 20 ms steps: it densifies, and its relative density on the matrix-free step is
+    within 0.002 of the direct one's (issue #53's bound for the layer's final density)."""
+    from taichi_sls.config import load_case
+    from taichi_sls.jobs.case_run import run_case
+
+    density = {}
+    for solver in ("direct", "matrix_free"):
+        sets = ["bed.count=8", "bed.z_range_um=[0.0, 60.0]", "contact.settle=false"]
+        sets += ["thermal.initial_C=200", "lasers.0.power_W=0", "time.adaptive=false"]
+        sets += ["time.dt_s=2e-2", "time.end_s=0.1", "output.png=false", "output.gif=false"]
+        sets.append(f"time.linear_solver={solver}")
+        summary = run_case(load_case("machine_layer3d", sets), tmp_path / solver, progress=False)
+        assert summary["linear_solves"]["solver"] == solver
+        density[solver] = summary["bed"]["relative_density"]
+    assert density["direct"]["final"] > density["direct"]["initial"] + 0.02, density
+    assert abs(density["matrix_free"]["final"] - density["direct"]["final"]) <= 0.002
+
+
 def test_refused_with_the_cells_dilatation():
     """The operator holds each point's own tangent, not the cell's volumetric one."""
     case = pair(2, 4.0, "matrix_free")
@@ -133,3 +169,23 @@ def test_a_hybrid_run_with_heat_takes_it(tmp_path):
     assert summary["status"] == "complete"
     assert summary["linear_solves"]["solver"] == "matrix_free"
     assert summary["linear_solves"]["cg_iterations"] > 0
+
+
+def test_a_krylov_solve_that_does_not_converge_stops_the_run_with_its_state(tmp_path, monkeypatch):
+    """CG held to one iteration cannot reach its tolerance: the run stops with a message that
+    says so and names the keys to change, its state written beside the frames already out
+    (failed_state.npz), never a step taken on an unconverged solve."""
+    from taichi_sls.jobs.case_run import run_case
+    from taichi_sls.solver import multigrid
+
+    monkeypatch.setattr(multigrid, "CG_MAX_ITERATIONS", 1)
+    data = pair(2, 4.0, "matrix_free", dt_s=1e-3)
+    data["time"]["end_s"] = 3e-3
+    data["output"] = {"frames": 3, "png": False, "gif": False}
+    summary = run_case(case_from_dict(data), tmp_path, progress=False)
+    assert summary["status"] == "failed"
+    assert "conjugate gradients with the multigrid" in summary["error"]
+    assert 'time.linear_solver = "direct"' in summary["error"]
+    assert "implicit_velocity_penalty" not in summary["error"]  # refused with matrix_free
+    assert (tmp_path / "failed_state.npz").is_file()
+    assert (tmp_path / "summary.json").is_file()
