@@ -112,6 +112,44 @@ def point_tangent_diagonal(
 
 
 @ti.kernel
+def point_tangent_matrix(
+    dim: ti.template(),
+    q: ti.types.ndarray(ndim=2),
+    unknown: ti.types.ndarray(ndim=1),
+    M: ti.types.ndarray(ndim=2),
+    shape: ti.types.ndarray(ndim=1),
+    inv_h: float,
+    h: float,
+    lp: float,
+    off: ti.i32,
+):
+    """M += K over the unknowns (a small grid's dense matrix, the multigrid's coarsest):
+    K_ij[a, c] = sum_p V_p (a_lambda g_i[a] g_j[c] + a_mu g_i[c] g_j[a] + a_mu (g_i . g_j)
+    delta_ac), g = grad N at point p, :func:`apply_point_tangent`'s operator as entries;
+    ``unknown``: each node component's row and column in M (flat node * dim + a), -1 where
+    it is not one."""
+    for p in range(q.shape[0]):
+        V, a_lam, a_mu = q[p, dim], q[p, dim + 1], q[p, dim + 2]
+        if V > 0.0:
+            n = ti.Vector([shape[d] for d in ti.static(range(dim))])
+            base, w, dw = _quadrature_stencil(dim, q, p, inv_h, h, lp, off, n)
+            G = stencil_gradients(w, dw)
+            for r, s in ti.ndrange(3**dim, 3**dim):
+                i = _node(base + stencil_offset(r, dim), n) * dim
+                j = _node(base + stencil_offset(s, dim), n) * dim
+                gg = 0.0
+                for b in ti.static(range(dim)):
+                    gg += G[r, b] * G[s, b]
+                for a, c in ti.static(ti.ndrange(dim, dim)):
+                    row, col = unknown[i + a], unknown[j + c]
+                    if row >= 0 and col >= 0:
+                        v = a_lam * G[r, a] * G[s, c] + a_mu * G[r, c] * G[s, a]
+                        if ti.static(a == c):
+                            v += a_mu * gg
+                        M[row, col] += V * v
+
+
+@ti.kernel
 def points_quadrature(st: ti.template(), q: ti.types.ndarray(ndim=2)):
     """The points as quadrature rows (:func:`apply_point_tangent`), their moduli those the
     implicit step's force pass kept."""

@@ -15,9 +15,9 @@ mass exceeds the mass cut scaled by its cell volume and no constrained fine comp
 lies under it. Prolongation P is linear interpolation between the node lattices, restriction
 its transpose. The smoother is Chebyshev on the dim x dim block-Jacobi operator D^-1 A, its
 largest eigenvalue estimated by power iterations on each level when the tangent is taken; the
-coarsest level is solved by a dense Cholesky factor of its matrix, probed by colours. The same
-polynomial before and after the coarse correction keeps the cycle symmetric positive definite,
-as CG needs.
+coarsest level is solved by a dense Cholesky factor of its matrix, assembled from its
+quadrature points. The same polynomial before and after the coarse correction keeps the cycle
+symmetric positive definite, as CG needs.
 """
 
 from dataclasses import dataclass, field
@@ -27,10 +27,10 @@ import scipy.linalg
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
-from ..physics.stiffness import REACH
 from ..physics.tangent_operator import (
     apply_point_tangent,
     point_tangent_diagonal,
+    point_tangent_matrix,
     points_quadrature,
 )
 from .fields import State
@@ -158,36 +158,30 @@ class GridMultigrid:
             level.lambda_max = EIGEN_SAFETY * self._power_iteration(k)
         self.coarsest = self._coarsest_factor()
 
-    def _coarsest_factor(self):
-        """The coarsest level's matrix, probed column by column in colours (nodes 5 apart along
-        every axis share a colour: no row reaches two of them), and its Cholesky factor; None
-        where it has more than COARSEST_UNKNOWNS unknowns or is not positive definite (the
-        cycle then smooths there instead)."""
+    def coarsest_matrix(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The coarsest level's unknowns (flat node * dim + component) and its matrix over
+        them, assembled from its quadrature points by one kernel (the tangent's entries, the
+        lumped mass over dt); None where the finest level is the only one or the coarsest has
+        more than COARSEST_UNKNOWNS unknowns."""
         k = len(self.levels) - 1
         level = self.levels[k]
         rows = np.flatnonzero(level.free.reshape(-1))
         if k == 0 or len(rows) > COARSEST_UNKNOWNS:
             return None
-        index = np.full(level.free.size, -1)
-        index[rows] = np.arange(len(rows))
-        node = np.stack(np.unravel_index(rows // self.dim, level.shape), axis=1)
-        width = 2 * REACH + 1
+        unknown = np.full(level.free.size, -1, dtype=np.int32)
+        unknown[rows] = np.arange(len(rows), dtype=np.int32)
         M = np.zeros((len(rows), len(rows)))
-        for colour in np.ndindex(*(width,) * self.dim):
-            column_node = node + (np.asarray(colour) - node + REACH) % width - REACH
-            inside = np.all((column_node >= 0) & (column_node < level.shape), axis=1)
-            flat = np.ravel_multi_index(
-                tuple(np.where(inside[:, None], column_node, 0).T), level.shape
-            )
-            probe_nodes = np.zeros(level.shape, dtype=bool)
-            probe_nodes[tuple(slice(c, None, width) for c in colour)] = True
-            for a in range(self.dim):
-                x = np.zeros((level.nodes, self.dim))
-                x[probe_nodes.reshape(-1), a] = 1.0
-                y = self.apply(k, x * level.free).reshape(-1)[rows]
-                col = np.where(inside, index[flat * self.dim + a], -1)
-                ok = col >= 0
-                M[np.flatnonzero(ok), col[ok]] = y[ok]
+        point_tangent_matrix(self.dim, level.quadrature, unknown, M, *self._grid(level))
+        M[np.diag_indices_from(M)] += np.repeat(level.mass / self.dt, self.dim)[rows]
+        return rows, M
+
+    def _coarsest_factor(self):
+        """:meth:`coarsest_matrix`'s Cholesky factor; None where there is none or the matrix
+        is not positive definite (the cycle then smooths there instead)."""
+        coarsest = self.coarsest_matrix()
+        if coarsest is None:
+            return None
+        rows, M = coarsest
         try:
             return rows, scipy.linalg.cho_factor(0.5 * (M + M.T))
         except np.linalg.LinAlgError:

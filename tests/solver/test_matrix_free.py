@@ -189,3 +189,20 @@ def test_a_krylov_solve_that_does_not_converge_stops_the_run_with_its_state(tmp_
     assert "implicit_velocity_penalty" not in summary["error"]  # refused with matrix_free
     assert (tmp_path / "failed_state.npz").is_file()
     assert (tmp_path / "summary.json").is_file()
+
+
+def test_the_coarsest_matrix_is_the_coarsest_operator():
+    """The coarsest level's matrix, assembled entry by entry from its quadrature points, is the
+    operator the cycle applies there (its tangent through the points and its lumped mass over
+    dt), on a random vector over its unknowns to round-off; symmetric, as its Cholesky needs."""
+    sim = Simulation(case_from_dict(pair(2, 2.0, "matrix_free", dt_s=1e-3)))
+    sim.advance_to(sim.dt)
+    multigrid = sim.implicit.linear.multigrid
+    k = len(multigrid.levels) - 1
+    rows, M = multigrid.coarsest_matrix()
+    x = np.zeros(multigrid.levels[k].free.size)
+    x[rows] = np.random.default_rng(1).standard_normal(len(rows))
+    applied = multigrid.apply(k, x.reshape(-1, 2)).reshape(-1)[rows]
+    assert k >= 1 and len(rows) > 100
+    assert np.linalg.norm(M @ x[rows] - applied) <= 1e-12 * np.linalg.norm(applied)
+    assert np.abs(M - M.T).max() <= 1e-12 * np.abs(M).max()
