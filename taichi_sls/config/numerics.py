@@ -203,7 +203,8 @@ class Time(Model):
         "node): dense over the grid (the fastest to assemble), or by blocks of 4 x 4 x 4 nodes "
         "allocated where the step writes (the nodes near material: less memory where material "
         "fills little of the box, somewhat slower to assemble; docs/record/implicit.md); auto: "
-        "blocks where the dense rows would pass 1 GiB. 2D: always dense",
+        "blocks where the dense rows would pass 1 GiB, and with linear_solver = matrix_free "
+        "(whose rows are the fixed part's alone). 2D: always dense",
     )
     heat_integrator: Literal["auto", "explicit", "implicit"] = Field(
         "auto",

@@ -179,12 +179,15 @@ DENSE_ROWS_MAX_BYTES = 2**30  # time.implicit_rows = "auto": blocks above this
 def sparse_rows(case: Case, grid: tuple[int, ...]) -> bool:
     """Whether the 3D implicit rows are stored by blocks (``time.implicit_rows``): asked for,
     or "auto" where the dense rows (WIDTH^3 neighbours, 1 + 9 values each, f64) pass
-    DENSE_ROWS_MAX_BYTES."""
+    DENSE_ROWS_MAX_BYTES, and always with the matrix-free step: it keeps the fixed part's rows
+    alone, which dense over the box outweigh the rest of its memory (2.6 against 1.1 kB a point
+    at 10k points, for a step 4 % slower; docs/record/implicit.md)."""
     rows = case.time.implicit_rows
     if case.domain.dim != 3 or not case.implicit_mechanics() or rows == "dense":
         return False
     dense_bytes = math.prod(grid) * ROW_WIDTH**3 * 8 * (1 + 9)
-    return rows == "blocks" or dense_bytes > DENSE_ROWS_MAX_BYTES
+    matrix_free = case.time.linear_solver == "matrix_free"
+    return rows == "blocks" or matrix_free or dense_bytes > DENSE_ROWS_MAX_BYTES
 
 
 def step_config(

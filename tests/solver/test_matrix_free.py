@@ -206,3 +206,21 @@ def test_the_coarsest_matrix_is_the_coarsest_operator():
     assert k >= 1 and len(rows) > 100
     assert np.linalg.norm(M @ x[rows] - applied) <= 1e-12 * np.linalg.norm(applied)
     assert np.abs(M - M.T).max() <= 1e-12 * np.abs(M).max()
+
+
+def test_auto_rows_take_the_blocks_with_the_matrix_free_step():
+    """time.implicit_rows = "auto" stores a small 3D scene's rows dense for the direct step and
+    by blocks for the matrix-free one (its fixed part's rows alone, which dense over the box
+    outweigh the rest of its memory); "dense" keeps them dense; 2D stays dense."""
+    from taichi_sls.solver.step_config import sparse_rows
+
+    grid = (37, 22, 22)
+    for solver, rows, expected in (
+        ("direct", "auto", False),
+        ("matrix_free", "auto", True),
+        ("matrix_free", "dense", False),
+    ):
+        case = pair(3, 4.0, solver)
+        case["time"]["implicit_rows"] = rows
+        assert sparse_rows(case_from_dict(case), grid) is expected, (solver, rows)
+    assert sparse_rows(case_from_dict(pair(2, 4.0, "matrix_free")), (37, 22)) is False
