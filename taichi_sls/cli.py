@@ -178,6 +178,7 @@ BENCHMARKS = {
     "symmetry": "a 3D pair's quarter under two mirror walls against the full domain",
     "spherepair": "3D coalescence of two liquid spheres against Frenkel and Pokluda",
     "isotropy": "a filleted pair's neck growth at 0, 30 and 45 deg to the grid",
+    "bedgrid": "a 3D layer's density and contacts over grids and bed draws",
 }
 
 

@@ -23,6 +23,13 @@ A point couples the nodes of its 3^dim stencil, so node i's row holds the 5^dim 
 of it: the matrix lives on the grid as ``K[I, I_j - I_i + 2, a, b]`` and solver/implicit.py
 gathers it into a sparse matrix. The fixed part (inertia, capillary stiffness) is a scalar times
 the identity in the components and lives as scalar rows ``K[I, I_j - I_i + 2]``.
+
+The points' tangent and the conduction matrix are symmetric, K_ji = K_ij^T, so the points write
+the upper triangle alone: the slots from the row's own node on, in the row's order
+(:func:`upper_slot`), and of the node's own 3x3 block its upper triangle; half the scatter of
+full rows. A reader takes a lower entry from where its transpose is stored
+(:func:`mirrored_slot`; solver/implicit_system.py, ``tangent_entry``), so the gathered matrix is
+exactly symmetric.
 """
 
 from taichi_sls.backend import ti
@@ -63,21 +70,41 @@ def stencil_offset(k, dim: ti.template(), side: ti.template() = 3):
 
 
 @ti.func
+def upper_slot(r, dim: ti.template()):
+    """Whether slot r of a row (its WIDTH^dim neighbours, the last axis fastest) is the row's
+    own node or after it: the half of a symmetric row the points write (module docstring). In
+    the stencil's order the same test is j >= i: both orders are lexicographic in the offset."""
+    return r >= (WIDTH**dim - 1) // 2
+
+
+@ti.func
+def mirrored_slot(I, o, r, dim: ti.template()):
+    """Where a symmetric row's slot r (offset o) of node I is stored: (node, offset, whether
+    transposed); a lower slot is the neighbour's upper slot towards I."""
+    lower = ti.cast(not upper_slot(r, dim), ti.i32)  # 1 below the row's own node
+    return I + lower * (o - REACH), o + lower * (2 * REACH - 2 * o), lower
+
+
+@ti.func
 def scatter_point_tangent(cfg: ti.template(), K: ti.template(), base, w, dw, V, a_lam, a_mu):
-    """K_ij += the tangent of one point (module docstring) over its stencil's node pairs."""
+    """K_ij += the tangent of one point (module docstring) over its stencil's node pairs, j
+    from i on (the upper half)."""
     G = stencil_gradients(w, dw)
     for i in range(3**cfg.dim):
         oi = stencil_offset(i, cfg.dim)
-        for j in range(3**cfg.dim):
+        for j in range(i, 3**cfg.dim):
             d = stencil_offset(j, cfg.dim) - oi + REACH
             gg = 0.0
             for c in ti.static(range(cfg.dim)):
                 gg += G[i, c] * G[j, c]
             for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
-                k = a_lam * G[i, a] * G[j, b] + a_mu * G[i, b] * G[j, a]
+                k = a_lam * (G[i, a] * G[j, b]) + a_mu * (G[i, b] * G[j, a])
                 if ti.static(a == b):
                     k += a_mu * gg
-                K[base + oi, d, a, b] += V * k
+                if ti.static(a <= b):
+                    K[base + oi, d, a, b] += V * k
+                elif i != j:  # a node's own block: its upper triangle alone
+                    K[base + oi, d, a, b] += V * k
 
 
 @ti.func
@@ -100,27 +127,42 @@ def scatter_tangent(
 
 @ti.func
 def scatter_cell_tangent(cfg: ti.template(), K: ti.template(), nd: ti.template(), xp, kappa_V):
-    """K_ij += kappa V g_i g_j^T over the corners i, j of x_p's cell, g the corner's gradient that
-    the cell's divergence takes: the corners lie in the point's stencil, so within the row's
-    REACH."""
+    """K_ij += kappa V g_i g_j^T over the corners i, j of x_p's cell (j at or after i: the
+    upper half), g the corner's gradient that the cell's divergence takes: the corners lie in
+    the point's stencil, so within the row's REACH."""
     c = point_cell(cfg, xp)
     rest, mass = light_corners(cfg, nd, c)
     for i in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
         gi = cell_gradient(cfg, nd, c, i, rest, mass)
         for j in ti.grouped(ti.ndrange(*CELL_CORNERS[cfg.dim])):
-            gj = cell_gradient(cfg, nd, c, j, rest, mass)
-            for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
-                K[c + i, j - i + REACH, a, b] += kappa_V * gi[a] * gj[b]
+            d = j - i + REACH
+            if upper_slot(flat_slot(d, cfg.dim), cfg.dim):
+                gj = cell_gradient(cfg, nd, c, j, rest, mass)
+                for a, b in ti.static(ti.ndrange(cfg.dim, cfg.dim)):
+                    if ti.static(a <= b):
+                        K[c + i, d, a, b] += kappa_V * (gi[a] * gj[b])
+                    elif (i != j).any():  # a node's own block: its upper triangle alone
+                        K[c + i, d, a, b] += kappa_V * (gi[a] * gj[b])
+
+
+@ti.func
+def flat_slot(o, dim: ti.template()):
+    """The slot of offset o in a row (the inverse of stencil_offset with side WIDTH)."""
+    r = 0
+    for d in ti.static(range(dim)):
+        r = r * WIDTH + o[d]
+    return r
 
 
 @ti.func
 def scatter_point_conductance(cfg: ti.template(), K: ti.template(), base, w, dw, Vk):
-    """K_ij += V_p k_p grad N_i . grad N_j over the stencil's node pairs: the conduction of
-    eq. 29, linear in the node temperatures, as the backward-Euler heat step's matrix."""
+    """K_ij += V_p k_p grad N_i . grad N_j over the stencil's node pairs, j from i on (the upper
+    half): the conduction of eq. 29, linear in the node temperatures, as the backward-Euler heat
+    step's matrix."""
     G = stencil_gradients(w, dw)
     for i in range(3**cfg.dim):
         oi = stencil_offset(i, cfg.dim)
-        for j in range(3**cfg.dim):
+        for j in range(i, 3**cfg.dim):
             gg = 0.0
             for c in ti.static(range(cfg.dim)):
                 gg += G[i, c] * G[j, c]

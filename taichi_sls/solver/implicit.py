@@ -100,8 +100,10 @@ class StepReport:
 
 # ----------------------------------------------------------------------------- kernels
 @ti.func
-def _clear_matrix(K: ti.template(), I, dim: ti.template()):
-    for r in range(WIDTH**dim):
+def _clear_matrix(K: ti.template(), I, dim: ti.template(), upper: ti.template() = False):
+    """Node I's row; ``upper``: its upper half alone, all that the points write of the
+    symmetric tangent (physics/stiffness.py)."""
+    for r in range((WIDTH**dim - 1) // 2 if ti.static(upper) else 0, WIDTH**dim):
         o = stencil_offset(r, dim, WIDTH)
         if ti.static(len(K.shape) == 2 * dim):  # scalar rows (the fixed part)
             K[I, o] = 0.0
@@ -195,7 +197,7 @@ def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         if ti.static(not st.cfg.sparse_rows and not st.cfg.matrix_free):
             if st.implicit.with_tangent[None]:
-                _clear_matrix(st.implicit.tangent, I, st.cfg.dim)
+                _clear_matrix(st.implicit.tangent, I, st.cfg.dim, True)
         st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         nd.v[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
     for k in range(v.shape[0]):

@@ -29,7 +29,7 @@ from taichi_sls.backend import ti
 from ..config import Case
 from ..physics.codes import HeatNode
 from ..physics.grid import active
-from ..physics.stiffness import REACH, WIDTH, scatter_point_conductance
+from ..physics.stiffness import REACH, WIDTH, mirrored_slot, scatter_point_conductance
 from ..physics.thermal import fixed_temperature, point_conductivity
 from . import struct_copy
 from .fields import State
@@ -105,12 +105,16 @@ def finish(st: ti.template()):
 @ti.func
 def _neighbour_unknown(st: ti.template(), I, r):
     """Slot r of node I's row (the WIDTH^dim nodes around it, the last axis fastest): the
-    neighbour's offset in the row and its unknown (-1: outside the grid or not free)."""
+    neighbour's unknown (-1: outside the grid or not free) and its conductance, which the points
+    wrote in the upper half of the symmetric rows alone (physics/stiffness.py)."""
     o, J, inside = row_neighbour(st.implicit.heat_dof, I, r)
     c = -1
+    k = 0.0
     if inside:
         c = st.implicit.heat_dof[J]
-    return o, c
+        M, q, flipped = mirrored_slot(I, o, r, st.cfg.dim)  # scalar rows: nothing to flip
+        k = st.implicit.conductance[M, q]
+    return o, c, k
 
 
 @ti.kernel
@@ -131,10 +135,10 @@ def rows_or_flow(
     for k in range(nodes.shape[0] * gather):
         I = ti.Vector([nodes[k, a] for a in ti.static(range(st.cfg.dim))])
         for r in range(WIDTH**st.cfg.dim):
-            o, c = _neighbour_unknown(st, I, r)
+            o, c, conductance = _neighbour_unknown(st, I, r)
             value = 0.0
             if c >= 0:
-                value = st.implicit.conductance[I, o]
+                value = conductance
                 if (o == REACH).all():
                     value += nd.heat_capacity[I] / dt
             vals[k, r] = value
@@ -144,9 +148,9 @@ def rows_or_flow(
         if not gather and st.implicit.heat_node[I] != HeatNode.EMPTY:
             flow = 0.0
             for r in range(WIDTH**st.cfg.dim):
-                o, c = _neighbour_unknown(st, I, r)
+                o, c, conductance = _neighbour_unknown(st, I, r)
                 if c >= 0:
-                    flow += st.implicit.conductance[I, o] * vec[c]
+                    flow += conductance * vec[c]
             st.nodes.heat_rate[I] -= flow
 
 

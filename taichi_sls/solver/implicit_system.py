@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from taichi_sls.backend import ti
 
-from ..physics.stiffness import REACH, WIDTH, stencil_offset
+from ..physics.stiffness import REACH, WIDTH, mirrored_slot, stencil_offset
 
 
 @ti.func
@@ -24,6 +24,19 @@ def row_neighbour(grid: ti.template(), I, r):
     J = I + o - REACH
     inside = (J >= 0).all() and (J < ti.Vector(ti.static(grid.shape))).all()
     return o, J, inside
+
+
+@ti.func
+def tangent_entry(K: ti.template(), I, o, r, a, b, dim: ti.template()):
+    """Entry (a, b) of slot r (offset o) of node I's row of the symmetric tangent, whose points
+    wrote its upper triangle alone (physics/stiffness.py)."""
+    J, q, flipped = mirrored_slot(I, o, r, dim)
+    value = 0.0
+    if flipped or (a > b and (q == REACH).all()):  # below the diagonal
+        value = K[J, q, b, a]
+    else:
+        value = K[J, q, a, b]
+    return value
 
 
 @ti.func
@@ -93,7 +106,8 @@ def gather(
                                 if a == b:  # a scalar times the identity (ImplicitFields)
                                     value = st.implicit.fixed[I, o]
                             elif ti.static(not st.cfg.matrix_free):
-                                value = st.implicit.tangent[I, o, a, b]
+                                K = ti.static(st.implicit.tangent)
+                                value = tangent_entry(K, I, o, r, a, b, st.cfg.dim)
                     vals[k, slot] = value
                     if part == Part.FIXED:
                         cols[k, slot] = c

@@ -42,6 +42,7 @@ def test_cholmod_and_amg_solve_the_elastic_system_of_a_cold_sphere():
     system = sim.implicit.prepare()
     _, tangent = sim.implicit.internal(system, system.v0)
     A = system.matrix(system.fixed + tangent)
+    assert abs(A - A.T).max() == 0.0  # the points write the upper triangle; a reader mirrors it
     inertia = system.fixed_matrix.diagonal()  # M / dt: no capillary stiffness here
     assert np.abs(tangent).max() > 10.0 * inertia.max()  # the elastic part dominates
     modes = system.rigid_body_modes()
