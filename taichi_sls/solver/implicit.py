@@ -101,8 +101,7 @@ class StepReport:
 # ----------------------------------------------------------------------------- kernels
 @ti.func
 def _clear_matrix(K: ti.template(), I, dim: ti.template(), upper: ti.template() = False):
-    """Node I's row; ``upper``: its upper half alone, all that the points write of the
-    symmetric tangent (physics/stiffness.py)."""
+    """Node I's row; ``upper``: the half the points write of the tangent (physics/stiffness.py)."""
     for r in range((WIDTH**dim - 1) // 2 if ti.static(upper) else 0, WIDTH**dim):
         o = stencil_offset(r, dim, WIDTH)
         if ti.static(len(K.shape) == 2 * dim):  # scalar rows (the fixed part)
