@@ -69,12 +69,30 @@ def stencil_offset(k, dim: ti.template(), side: ti.template() = 3):
     return o
 
 
+def own_slot(dim: int) -> int:
+    """The slot of a row's own node (the middle of its WIDTH^dim, the last axis fastest)."""
+    return (WIDTH**dim - 1) // 2
+
+
 @ti.func
 def upper_slot(r, dim: ti.template()):
-    """Whether slot r of a row (its WIDTH^dim neighbours, the last axis fastest) is the row's
-    own node or after it: the half of a symmetric row the points write (module docstring). In
-    the stencil's order the same test is j >= i: both orders are lexicographic in the offset."""
-    return r >= (WIDTH**dim - 1) // 2
+    """Whether slot r of a row is the row's own node or after it: the half of a symmetric row
+    the points write (module docstring). In the stencil's order the same test is j >= i: both
+    orders are lexicographic in the offset."""
+    return r >= ti.static(own_slot(dim))
+
+
+@ti.func
+def clear_row(K: ti.template(), I, dim: ti.template(), upper: ti.template() = False):
+    """Node I's row of K (scalar rows, or dim x dim blocks); ``upper``: the half the points
+    write of a symmetric one."""
+    for r in range(own_slot(dim) if ti.static(upper) else 0, WIDTH**dim):
+        o = stencil_offset(r, dim, WIDTH)
+        if ti.static(len(K.shape) == 2 * dim):  # scalar rows (the fixed part)
+            K[I, o] = 0.0
+        else:
+            for a, b in ti.static(ti.ndrange(dim, dim)):
+                K[I, o, a, b] = 0.0
 
 
 @ti.func

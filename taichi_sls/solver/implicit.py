@@ -48,9 +48,9 @@ from ..physics.small_matrix import ZERO_VECTOR
 from ..physics.stiffness import (
     WIDTH,
     capillary_tangent,
+    clear_row,
     scatter_mass,
     scatter_tangent,
-    stencil_offset,
 )
 from . import checkpoint, struct_copy
 from .envelope import Envelope, envelope_pattern, pin
@@ -99,18 +99,6 @@ class StepReport:
 
 
 # ----------------------------------------------------------------------------- kernels
-@ti.func
-def _clear_matrix(K: ti.template(), I, dim: ti.template(), upper: ti.template() = False):
-    """Node I's row; ``upper``: the half the points write of the tangent (physics/stiffness.py)."""
-    for r in range((WIDTH**dim - 1) // 2 if ti.static(upper) else 0, WIDTH**dim):
-        o = stencil_offset(r, dim, WIDTH)
-        if ti.static(len(K.shape) == 2 * dim):  # scalar rows (the fixed part)
-            K[I, o] = 0.0
-        else:
-            for a, b in ti.static(ti.ndrange(dim, dim)):
-                K[I, o, a, b] = 0.0
-
-
 def begin(st: State) -> None:
     """Everything of the step before the Newton loop (module docstring)."""
     if st.cfg.sparse_rows:
@@ -126,7 +114,7 @@ def _begin(st: ti.template()):
     dt = st.scalars.dt[None]
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         if ti.static(not st.cfg.sparse_rows):
-            _clear_matrix(st.implicit.fixed, I, st.cfg.dim)
+            clear_row(st.implicit.fixed, I, st.cfg.dim)
         m = nd.mass[I]
         vn = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         free = ti.Vector.zero(ti.i32, st.cfg.dim)
@@ -196,7 +184,7 @@ def _internal_force(st: ti.template(), v: ti.template(), dof_node: ti.template()
     for I in ti.grouped(ti.ndrange(*active(st.box))):
         if ti.static(not st.cfg.sparse_rows and not st.cfg.matrix_free):
             if st.implicit.with_tangent[None]:
-                _clear_matrix(st.implicit.tangent, I, st.cfg.dim, True)
+                clear_row(st.implicit.tangent, I, st.cfg.dim, True)
         st.implicit.internal[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
         nd.v[I] = ti.Vector(ZERO_VECTOR[st.cfg.dim])
     for k in range(v.shape[0]):

@@ -29,7 +29,13 @@ from taichi_sls.backend import ti
 from ..config import Case
 from ..physics.codes import HeatNode
 from ..physics.grid import active
-from ..physics.stiffness import REACH, WIDTH, mirrored_slot, scatter_point_conductance
+from ..physics.stiffness import (
+    REACH,
+    WIDTH,
+    clear_row,
+    mirrored_slot,
+    scatter_point_conductance,
+)
 from ..physics.thermal import fixed_temperature, point_conductivity
 from . import struct_copy
 from .fields import State
@@ -83,8 +89,7 @@ def rates_and_conductance(st: ti.template()):
         stage(st, True, False)
     nd = ti.static(st.nodes)
     for I in ti.grouped(ti.ndrange(*active(st.box))):
-        for o in ti.grouped(ti.ndrange(*((WIDTH,) * st.cfg.dim))):
-            st.implicit.conductance[I, o] = 0.0
+        clear_row(st.implicit.conductance, I, st.cfg.dim, True)
         kind = HeatNode.EMPTY
         if nd.heat_capacity[I] > 0.0:
             kind = HeatNode.FREE
@@ -112,8 +117,9 @@ def _neighbour_unknown(st: ti.template(), I, r):
     k = 0.0
     if inside:
         c = st.implicit.heat_dof[J]
-        M, q, flipped = mirrored_slot(I, o, r, st.cfg.dim)  # scalar rows: nothing to flip
-        k = st.implicit.conductance[M, q]
+        if c >= 0:
+            M, q, flipped = mirrored_slot(I, o, r, st.cfg.dim)  # scalar rows: nothing to flip
+            k = st.implicit.conductance[M, q]
     return o, c, k
 
 
